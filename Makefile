@@ -1,0 +1,38 @@
+# Two set-up commands on a fresh machine (each makes its own virtual environment):
+#   make demo   - simulate the reference rig and draw the plots (bundled defaults)
+#   make test   - lint and run the test suite
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+# DDS never leaves this machine; a private domain unless the caller chose one.
+export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
+export ROS_DOMAIN_ID ?= 42
+
+.PHONY: demo test bench lint clean
+
+$(STAMP): setup.py setup.cfg
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install --quiet --upgrade pip
+	$(BIN)/pip install --quiet -e '.[ros,test]'
+	touch $(STAMP)
+
+demo: $(STAMP)
+	rm -rf out/brake_const_30bar_bag
+	$(BIN)/landing-gear-sim simulate --pressure-bar 30 -o out/brake_const_30bar.csv --bag out/brake_const_30bar_bag
+	$(BIN)/landing-gear-sim simulate --pressure-bar 45 -o out/brake_const_45bar.csv
+	$(BIN)/landing-gear-sim simulate --profile osc-low -o out/brake_osc_low.csv
+	$(BIN)/landing-gear-sim bode -o out/bode.png
+
+lint: $(STAMP)
+	$(BIN)/ruff check landing_gear_sim antiskid msg_tools test bench
+
+test: lint
+	$(BIN)/python -m pytest -q test
+
+bench: $(STAMP)
+	$(BIN)/python bench/run.py
+
+clean:
+	rm -rf $(VENV) out build install log .pytest_cache
+	find . -name __pycache__ -type d -prune -exec rm -rf {} +

@@ -1,0 +1,7 @@
+"""landing_gear_sim: digital twin of an aircraft landing-gear anti-skid test rig.
+
+The physics and analysis here never import ROS; ``landing_gear_sim.nodes`` holds
+the thin rclpy adapters.
+"""
+
+__version__ = "0.1.0"

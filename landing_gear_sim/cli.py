@@ -1,0 +1,254 @@
+"""``landing-gear-sim``: the command-line front end.
+
+Every user error ends as one line ``landing-gear-sim: error: ...`` and exit code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from msg_tools.errors import RunFormatError
+
+from . import scenario as sc
+from .errors import LandingGearSimError
+from .parameters import ELEMENTS, SPECS, RigParameters, load_parameters, parse_assignment
+
+PROG = "landing-gear-sim"
+
+# profile name -> (builder, wheel on the flywheel?, actuator-test duration [s])
+PROFILES: dict[str, tuple[Callable[[argparse.Namespace, RigParameters], sc.Profile], bool, float]]
+PROFILES = {
+    "constant": (lambda a, p: sc.constant(_constant_level(a, p)), True, 0.0),
+    "osc-low": (lambda a, p: sc.oscillating(**sc.OSC_LOW), True, 0.0),
+    "osc-high": (lambda a, p: sc.oscillating(**sc.OSC_HIGH), True, 0.0),
+    "ramp": (lambda a, p: sc.quasi_static_ramp(p.number("actuator.max_current_a")), False, 20.0),
+    "steps": (lambda a, p: sc.steps(), False, 8.0),
+    "sweep": (lambda a, p: sc.sine_sweep(), False, 20.0),
+    "steps-sweep": (lambda a, p: sc.steps_then_sweep(), False, 28.0),
+}
+
+
+def _progress(message: str) -> None:
+    print(f"[{PROG}] {message}", file=sys.stderr, flush=True)
+
+
+def _constant_level(args: argparse.Namespace, params: RigParameters) -> float:
+    if args.current_a is not None:
+        return float(args.current_a)
+    return sc.current_for_pressure(params, args.pressure_bar * 1e5)
+
+
+def _add_params_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--config", action="append", type=Path, metavar="FILE",
+                        help="ROS 2 params file; repeat to layer (default: bundled reference rig)")
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="override one parameter, e.g. --set friction.theta1=0.8")
+    parser.add_argument("--without", action="append", default=[], choices=ELEMENTS,
+                        metavar="ELEMENT", help=f"switch an element off ({', '.join(ELEMENTS)})")
+
+
+def _params(args: argparse.Namespace) -> RigParameters:
+    overrides = dict(parse_assignment(text) for text in args.set)
+    params = load_parameters(args.config, overrides or None)
+    return params.without(*args.without) if args.without else params
+
+
+def _build_scenario(args: argparse.Namespace, params: RigParameters) -> sc.Scenario:
+    rate = args.rate or None
+    if args.profile == "file":
+        if args.file is None:
+            raise LandingGearSimError("--profile file needs --file RUN.csv")
+        profile, duration = sc.from_file(args.file)
+        contact = not args.actuator_only
+        name = Path(args.file).stem + "_sim"
+    else:
+        build, contact, duration = PROFILES[args.profile]
+        profile = build(args, params)
+        contact = (contact or args.rig) and not args.actuator_only
+        name = args.profile.replace("-", "_")
+        if args.profile == "constant":
+            name = f"brake_const_{args.pressure_bar:g}bar" if args.current_a is None \
+                else f"brake_const_{args.current_a:g}A"
+    if args.duration:
+        duration = args.duration
+    if contact:
+        if args.profile == "file":  # a recorded run already holds its braking start
+            times = sc.sample_times(duration, rate or params.number("simulation.output_rate_hz"))
+            return sc.Scenario(name, profile(times), 1.0 / (times[1] - times[0]), True,
+                               params.number("rig_test.initial_speed_m_s"),
+                               params.number("rig_test.stop_speed_m_s"), "replayed current")
+        return sc.rig_test(params, profile, name, rate)
+    return sc.actuator_test(params, profile, duration or 10.0, name, rate)
+
+
+def _summary(result: object) -> str:
+    from .integrate import SimulationResult
+
+    assert isinstance(result, SimulationResult)
+    lines = [f"{result.scenario.name}: {len(result)} samples, {result.time_s[-1]:.3f} s "
+             f"({result.stop_reason}); max pressure {result.pressure_pa.max() / 1e5:.2f} bar"]
+    if result.scenario.contact:
+        braking = result.pressure_pa > 1e4
+        locked = (result.wheel_speed_rad_s <= 0) & braking
+        lines.append(f"  speed {result.speed_m_s[0]:.2f} -> {result.speed_m_s[-1]:.2f} m/s, "
+                     f"max slip {result.slip[braking].max() if braking.any() else 0.0:.3f}, "
+                     f"wheel locked {locked.sum() / result.scenario.rate_hz:.3f} s")
+    return "\n".join(lines)
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    from msg_tools.bag_io import write_bag
+    from msg_tools.csv_io import write_csv
+
+    from .integrate import simulate
+    from .plotting import plot_simulation
+
+    if args.bag and args.bag.exists():  # fail before anything is written
+        raise LandingGearSimError(f"{args.bag}: exists already; remove it or choose another --bag")
+    params = _params(args)
+    scenario = _build_scenario(args, params)
+    _progress(f"simulating {scenario.name} (up to {scenario.duration_s:.1f} s at "
+              f"{scenario.rate_hz:g} Hz; the first run compiles the physics, ~10 s)")
+    started = time.perf_counter()
+    result = simulate(params, scenario)
+    _progress(f"simulated in {time.perf_counter() - started:.2f} s")
+    output = args.output or Path("out") / f"{scenario.name}.csv"
+    output.parent.mkdir(parents=True, exist_ok=True)
+    run = result.to_run(args.noise_seed)
+    write_csv(run, output)
+    print(_summary(result))
+    print(f"  csv:  {output}")
+    if args.bag:
+        write_bag(run, args.bag, args.storage)
+        print(f"  bag:  {args.bag} ({args.storage})")
+    if not args.no_plot:
+        plot = plot_simulation(result, args.plot or output.with_suffix(".png"))
+        print(f"  plot: {plot}")
+    return 0
+
+
+def cmd_bode(args: argparse.Namespace) -> int:
+    from .linear import frequency_response, resonance_hz
+    from .plotting import plot_bode
+
+    params = _params(args)
+    frequencies = np.logspace(np.log10(args.fmin), np.log10(args.fmax), 800)
+    variants = [params] if not params.has("gear_walk") else [params, params.without("gear_walk")]
+    responses = [frequency_response(v, speed, frequencies, args.slip)
+                 for speed in args.speeds for v in variants]
+    for response in responses:
+        peak = resonance_hz(response)
+        where = f"resonance {peak:.2f} Hz" if peak else "no resonance"
+        print(f"{response.speed_m_s:6.1f} m/s, {'with' if response.gear_walk else 'without'} "
+              f"gear walk: |G_lambda(0)| = {abs(response.slip[0]):.3g} 1/(N m), {where}")
+    print(f"plot: {plot_bode(responses, args.output)}")
+    return 0
+
+
+def cmd_params(args: argparse.Namespace) -> int:
+    params = _params(args)
+    if args.write:
+        params.to_yaml(args.write)
+        print(f"wrote {args.write}")
+        return 0
+    print(f"# from: {', '.join(params.sources)}")
+    for spec in SPECS:
+        print(f"{spec.key:40s} {params[spec.key]!s:>14}  [{spec.unit}]  {spec.description}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog=PROG, description="Landing-gear anti-skid rig "
+                                     "digital twin: simulate, analyse, compare.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    sim = sub.add_parser("simulate", help="simulate a rig test; write CSV (+ bag) and a plot")
+    _add_params_arguments(sim)
+    sim.add_argument("--profile", choices=[*PROFILES, "file"], default="constant",
+                     help="valve current profile (default: constant)")
+    sim.add_argument("--pressure-bar", type=float, default=30.0,
+                     help="constant profile: target pressure (default 30 bar)")
+    sim.add_argument("--current-a", type=float, help="constant profile: current instead")
+    sim.add_argument("--file", type=Path, help="--profile file: run CSV whose current to use")
+    where = sim.add_mutually_exclusive_group()
+    where.add_argument("--actuator-only", action="store_true", help="wheel off the flywheel")
+    where.add_argument("--rig", action="store_true", help="wheel on the flywheel")
+    sim.add_argument("--duration", type=float, help="input duration [s] (actuator tests)")
+    sim.add_argument("--rate", type=float, help="output rate [Hz] (default from config)")
+    sim.add_argument("--noise-seed", type=int, help="seed of the sensor noise (sensors.*)")
+    sim.add_argument("-o", "--output", type=Path, help="CSV path (default out/<name>.csv)")
+    sim.add_argument("--bag", type=Path, help="also write a rosbag2 folder here")
+    sim.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
+    sim.add_argument("--plot", type=Path, help="PNG path (default next to the CSV)")
+    sim.add_argument("--no-plot", action="store_true")
+    sim.set_defaults(func=cmd_simulate)
+
+    bode = sub.add_parser("bode", help="frequency responses G_lambda, G_eta (paper Fig. 7)")
+    _add_params_arguments(bode)
+    bode.add_argument("--speeds", type=float, nargs="+", default=[10.0, 30.0, 60.0],
+                      help="operating speeds [m/s]")
+    bode.add_argument("--slip", type=float, default=0.05, help="operating slip (default 0.05)")
+    bode.add_argument("--fmin", type=float, default=0.1)
+    bode.add_argument("--fmax", type=float, default=100.0)
+    bode.add_argument("-o", "--output", type=Path, default=Path("out/bode.png"))
+    bode.set_defaults(func=cmd_bode)
+
+    show = sub.add_parser("params", help="show (or write) the effective parameter set")
+    _add_params_arguments(show)
+    show.add_argument("--write", type=Path, help="write the merged set as a params file")
+    show.set_defaults(func=cmd_params)
+    return parser
+
+
+def _version() -> str:
+    from . import __version__
+
+    return __version__
+
+
+def _check(args: argparse.Namespace, parser: argparse.ArgumentParser) -> None:
+    if args.command == "simulate":
+        if args.rate is not None and args.rate <= 0:
+            parser.error("--rate must be > 0")
+        if args.duration is not None and args.duration <= 0:
+            parser.error("--duration must be > 0")
+    if args.command == "bode":
+        if not 0 < args.slip < 1:
+            parser.error("--slip must be in (0, 1)")
+        if not 0 < args.fmin < args.fmax:
+            parser.error("need 0 < --fmin < --fmax")
+        if any(v <= 0 for v in args.speeds):
+            parser.error("--speeds must be > 0")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    _check(args, parser)
+    try:
+        return int(args.func(args))
+    except (LandingGearSimError, RunFormatError) as exc:
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return 130
+
+
+def _entry(command: str) -> Callable[[], int]:
+    def run() -> int:
+        return main([command, *sys.argv[1:]])
+
+    return run
+
+
+simulate_main = _entry("simulate")
+bode_main = _entry("bode")

@@ -1,0 +1,42 @@
+"""The data contract of a measured rig run (docs/design.md, section 4).
+
+CSV columns carry the units users read (bar); everything inside is SI (Pa).
+"""
+
+from __future__ import annotations
+
+PA_PER_BAR = 1e5
+ATMOSPHERE_PA = 101325.0  # FluidPressure is absolute: gauge + 1 atm
+
+CSV_COLUMNS: tuple[str, ...] = (
+    "time_s", "current_ref_A", "brake_pressure_bar", "wheel_speed_rad_s",
+    "flywheel_speed_rad_s", "vertical_load_N", "longitudinal_force_N",
+)
+"""Contract CSV header names, in the order we write them (readers accept any order)."""
+
+CSV_SCALE_TO_SI: dict[str, float] = {
+    "time_s": 1.0, "current_ref_A": 1.0, "brake_pressure_bar": PA_PER_BAR,
+    "wheel_speed_rad_s": 1.0, "flywheel_speed_rad_s": 1.0, "vertical_load_N": 1.0,
+    "longitudinal_force_N": 1.0,
+}
+
+CSV_TO_FIELD: dict[str, str] = {
+    "time_s": "time_s", "current_ref_A": "current_a", "brake_pressure_bar": "pressure_pa",
+    "wheel_speed_rad_s": "wheel_speed_rad_s", "flywheel_speed_rad_s": "flywheel_speed_rad_s",
+    "vertical_load_N": "vertical_load_n", "longitudinal_force_N": "longitudinal_force_n",
+}
+"""CSV column → :class:`msg_tools.run.Run` field."""
+
+TOPIC_CURRENT = "/rig/brake/current_ref"
+TOPIC_PRESSURE = "/rig/brake/pressure"
+TOPIC_WHEEL = "/rig/wheel/joint_state"
+TOPIC_FLYWHEEL = "/rig/flywheel/joint_state"
+TOPIC_WRENCH = "/rig/load_cell/wrench"
+
+TOPIC_TYPES: dict[str, str] = {
+    TOPIC_CURRENT: "std_msgs/msg/Float64",
+    TOPIC_PRESSURE: "sensor_msgs/msg/FluidPressure",
+    TOPIC_WHEEL: "sensor_msgs/msg/JointState",
+    TOPIC_FLYWHEEL: "sensor_msgs/msg/JointState",
+    TOPIC_WRENCH: "geometry_msgs/msg/WrenchStamped",
+}

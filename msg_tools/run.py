@@ -1,0 +1,54 @@
+"""The typed run object every tool works on."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import RunFormatError
+
+SIGNALS: tuple[str, ...] = (
+    "current_a", "pressure_pa", "wheel_speed_rad_s", "flywheel_speed_rad_s",
+    "vertical_load_n", "longitudinal_force_n",
+)
+"""Signal fields of a :class:`Run`, besides ``time_s``."""
+
+
+@dataclass(frozen=True)
+class Run:
+    """One rig test on a common time base, SI units.
+
+    All arrays have shape (n,). ``pressure_pa`` is gauge pressure;
+    ``longitudinal_force_n`` is positive when braking.
+    """
+
+    name: str
+    time_s: np.ndarray
+    current_a: np.ndarray
+    pressure_pa: np.ndarray
+    wheel_speed_rad_s: np.ndarray
+    flywheel_speed_rad_s: np.ndarray
+    vertical_load_n: np.ndarray
+    longitudinal_force_n: np.ndarray
+    source: str = field(default="")
+
+    def __post_init__(self) -> None:
+        n = np.shape(self.time_s)
+        for name in ("time_s", *SIGNALS):
+            value = np.asarray(getattr(self, name), dtype=float)
+            if value.shape != n or value.ndim != 1:
+                raise RunFormatError(f"{self.source or self.name}: {name} has shape "
+                                     f"{value.shape}, expected {n}")
+            object.__setattr__(self, name, value)
+        if value.size < 2 or np.any(np.diff(self.time_s) <= 0):
+            raise RunFormatError(f"{self.source or self.name}: time must be strictly "
+                                 "increasing with at least 2 samples")
+
+    @property
+    def rate_hz(self) -> float:
+        """Mean sample rate."""
+        return (self.time_s.size - 1) / float(self.time_s[-1] - self.time_s[0])
+
+    def __len__(self) -> int:
+        return int(self.time_s.size)

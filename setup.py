@@ -1,0 +1,57 @@
+"""One ament_python package holding three Python packages: landing_gear_sim, antiskid, msg_tools."""
+
+from glob import glob
+
+from setuptools import find_packages, setup
+
+PACKAGE = "landing_gear_sim"
+
+setup(
+    name=PACKAGE,
+    version="0.1.0",
+    description="Digital twin of an aircraft landing-gear anti-skid test rig",
+    license="Apache-2.0",
+    python_requires=">=3.10",
+    packages=find_packages(include=[PACKAGE, f"{PACKAGE}.*", "antiskid", "antiskid.*",
+                                    "msg_tools", "msg_tools.*"]),
+    data_files=[
+        ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
+        (f"share/{PACKAGE}", ["package.xml"]),
+        (f"share/{PACKAGE}/config", glob("config/*.yaml")),
+    ],
+    install_requires=[
+        "numpy>=1.24",
+        "scipy>=1.10",
+        "numba>=0.59",
+        "matplotlib>=3.7",
+        "PyYAML>=6.0",
+        "rosbags>=0.11",
+    ],
+    extras_require={
+        # ROS 2 Kilted from PyPI, for machines without a ROS install. Optional so that
+        # it never shadows a system ROS inside a workspace.
+        "ros": [
+            "ros-rclpy",
+            "ros-std-msgs",
+            "ros-sensor-msgs",
+            "ros-geometry-msgs",
+            "ros-rosgraph-msgs",
+            "ros-rmw-fastrtps-cpp",
+            "ros-ament-index-python",
+        ],
+        "test": [
+            "pytest>=7",
+            "ruff>=0.5",
+            "colcon-common-extensions",
+            "colcon-ros",
+            "ros-ament-index-python",
+        ],
+    },
+    entry_points={
+        "console_scripts": [
+            "landing-gear-sim = landing_gear_sim.cli:main",
+            "simulate = landing_gear_sim.cli:simulate_main",
+            "bode = landing_gear_sim.cli:bode_main",
+        ],
+    },
+)

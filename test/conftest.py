@@ -1,0 +1,20 @@
+"""Test-session set-up: DDS stays on this machine, on a domain private to this process."""
+
+from __future__ import annotations
+
+import os
+
+# Set before anything can import rclpy: Fast DDS would otherwise multicast on the LAN,
+# and parallel test processes would cross-talk on a shared domain.
+os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+os.environ["ROS_DOMAIN_ID"] = str(1 + os.getpid() % 100)
+
+import pytest
+
+from landing_gear_sim.parameters import RigParameters, load_parameters
+
+
+@pytest.fixture(scope="session")
+def reference() -> RigParameters:
+    """The bundled reference-rig parameter set."""
+    return load_parameters()

@@ -1,0 +1,111 @@
+"""The landing-gear-sim command line, as a user runs it."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from landing_gear_sim.cli import main
+from msg_tools.bag_io import read_bag
+from msg_tools.csv_io import read_csv
+
+
+def test_simulate_writes_csv_bag_and_plot(tmp_path, capsys):
+    csv, bag = tmp_path / "run.csv", tmp_path / "bag"
+    assert main(["simulate", "--pressure-bar", "30", "-o", str(csv), "--bag", str(bag)]) == 0
+    out = capsys.readouterr().out
+    assert "stop speed reached" in out and "wheel locked 0.000 s" in out
+    run = read_csv(csv)
+    assert run.time_s[-1] > 10.0 and run.flywheel_speed_rad_s[0] == 60.0
+    assert len(read_bag(bag)) == len(run)
+    assert csv.with_suffix(".png").stat().st_size > 10_000
+
+
+def test_simulate_reports_a_lock_at_45_bar(tmp_path, capsys):
+    assert main(["simulate", "--pressure-bar", "45", "-o", str(tmp_path / "r.csv"),
+                 "--no-plot"]) == 0
+    locked_s = float(capsys.readouterr().out.split("wheel locked ")[1].split(" s")[0])
+    assert locked_s > 1.0
+
+
+def test_actuator_profile_runs_with_the_wheel_off(tmp_path):
+    csv = tmp_path / "sweep.csv"
+    assert main(["simulate", "--profile", "sweep", "--duration", "2", "-o", str(csv),
+                 "--no-plot"]) == 0
+    run = read_csv(csv)
+    assert run.time_s[-1] == pytest.approx(1.999)
+    assert run.wheel_speed_rad_s.max() == 0.0 and run.pressure_pa.max() > 20e5
+
+
+def test_replaying_a_recorded_current_reproduces_the_run(tmp_path):
+    first, second = tmp_path / "a.csv", tmp_path / "b.csv"
+    assert main(["simulate", "--profile", "osc-high", "-o", str(first), "--no-plot"]) == 0
+    assert main(["simulate", "--profile", "file", "--file", str(first), "-o", str(second),
+                 "--no-plot"]) == 0
+    a, b = read_csv(first), read_csv(second)
+    n = min(len(a), len(b))
+    assert abs(len(a) - len(b)) <= 1
+    assert (abs(a.wheel_speed_rad_s[:n] - b.wheel_speed_rad_s[:n])).max() < 1e-9
+
+
+@pytest.mark.parametrize(("argv", "fragment"), [
+    (["simulate", "--pressure-bar", "99"], "outside the valve range"),
+    (["simulate", "--set", "friction.theta1=-1"], "'friction.theta1' must not be negative"),
+    (["simulate", "--set", "friction.thta1=1"], "did you mean 'friction.theta1'"),
+    (["simulate", "--config", "/no/such.yaml"], "/no/such.yaml: cannot read"),
+    (["simulate", "--profile", "file"], "--profile file needs --file"),
+    (["simulate", "--profile", "file", "--file", "/no/run.csv"], "/no/run.csv: cannot read"),
+])
+def test_bad_input_is_one_error_line_and_exit_2(argv, fragment, capsys, tmp_path):
+    assert main([*argv, "-o", str(tmp_path / "x.csv")]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert lines[-1].startswith("landing-gear-sim: error:") and fragment in lines[-1]
+    assert not any("Traceback" in line for line in lines)
+    assert not (tmp_path / "x.csv").exists()
+
+
+def test_bad_arguments_exit_2(capsys):
+    for argv in (["simulate", "--rate", "-1"], ["bode", "--slip", "1.5"], ["frobnicate"]):
+        with pytest.raises(SystemExit) as exit_info:
+            main(argv)
+        assert exit_info.value.code == 2
+    capsys.readouterr()
+
+
+def test_existing_bag_stops_the_run_before_anything_is_written(tmp_path, capsys):
+    csv, bag = tmp_path / "keep.csv", tmp_path / "bag"
+    csv.write_text("precious\n")
+    bag.mkdir()
+    assert main(["simulate", "-o", str(csv), "--bag", str(bag)]) == 2
+    assert "exists already" in capsys.readouterr().err
+    assert csv.read_text() == "precious\n"
+
+
+def test_bode_finds_the_gear_walk_resonance(tmp_path, capsys):
+    png = tmp_path / "bode.png"
+    assert main(["bode", "--speeds", "20", "-o", str(png)]) == 0
+    out = capsys.readouterr().out
+    assert "with gear walk" in out and "resonance 7." in out
+    assert "without gear walk" in out and "no resonance" in out
+    assert png.stat().st_size > 10_000
+
+
+def test_params_shows_and_writes_the_effective_set(tmp_path, capsys):
+    assert main(["params", "--without", "gear_walk", "--set", "friction.theta1=0.9"]) == 0
+    out = capsys.readouterr().out
+    assert "reference_rig.yaml" in out and "0.9" in out
+    written = tmp_path / "mine.yaml"
+    assert main(["params", "--set", "friction.theta1=0.9", "--write", str(written)]) == 0
+    assert main(["params", "--config", str(written)]) == 0
+    assert "friction.theta1" in capsys.readouterr().out
+
+
+def test_console_script_is_installed():
+    script = Path(sys.executable).parent / "landing-gear-sim"
+    result = subprocess.run([str(script), "--version"], capture_output=True, text=True,
+                            env=os.environ, check=False)
+    assert result.returncode == 0 and "landing-gear-sim" in result.stdout

@@ -1,0 +1,153 @@
+"""The params-file loader: reference values, layering, and a clear error for each bad value."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from landing_gear_sim.errors import ParameterError
+from landing_gear_sim.parameters import (
+    INDEX,
+    N_PARAMS,
+    SPECS,
+    default_config_dir,
+    load_parameters,
+    parse_assignment,
+)
+
+REFERENCE = default_config_dir() / "reference_rig.yaml"
+
+
+def _write_variant(tmp_path: Path, key: str, value: object, drop: bool = False) -> Path:
+    """The reference file with one key changed (or removed)."""
+    document = yaml.safe_load(REFERENCE.read_text())
+    section = document["/**"]["ros__parameters"]
+    *parents, leaf = key.split(".")
+    for part in parents:
+        section = section[part]
+    if drop:
+        del section[leaf]
+    else:
+        section[leaf] = value
+    path = tmp_path / "variant.yaml"
+    path.write_text(yaml.safe_dump(document))
+    return path
+
+
+def test_reference_rig_holds_the_datasheet_in_si(reference):
+    assert reference.configuration == "rig"
+    assert reference.number("brake.gain_n_m_per_pa") * 1e5 == pytest.approx(150.0)
+    assert reference.number("actuator.map_k1_pa_per_a") / 1e5 == pytest.approx(70.0)
+    assert reference.number("gear_walk.stiffness_n_m_per_rad") == 6.9e5
+    wn = math.sqrt(6.9e5 / reference.number("gear_walk.inertia_kg_m2")) / (2 * math.pi)
+    assert wn == pytest.approx(8.0, abs=0.05)
+    assert all(reference.has(e) for e in ("gear_walk", "drag", "actuator_dynamics"))
+
+
+def test_vector_packs_every_key_at_its_index(reference):
+    vector = reference.vector()
+    assert vector.shape == (N_PARAMS,)
+    assert vector[INDEX["friction.theta2"]] == 28.0
+    assert vector[INDEX["configuration"]] == 0.0
+    assert np.all(np.isfinite(vector))
+
+
+@pytest.mark.parametrize(("value", "fragment"), [
+    (-3500.0, "must not be negative"),
+    (float("nan"), "must be finite"),
+    (float("inf"), "must be finite"),
+    (0.0, "must be > 0"),
+    ("heavy", "must be a number"),
+    (True, "must be a number"),
+])
+def test_bad_value_names_key_and_file(tmp_path, value, fragment):
+    path = _write_variant(tmp_path, "flywheel.inertia_kg_m2", value)
+    with pytest.raises(ParameterError) as error:
+        load_parameters([path])
+    message = str(error.value)
+    assert "flywheel.inertia_kg_m2" in message
+    assert str(path) in message
+    assert fragment in message
+
+
+def test_missing_value_names_key_and_files(tmp_path):
+    path = _write_variant(tmp_path, "friction.theta3", None, drop=True)
+    with pytest.raises(ParameterError, match=r"'friction.theta3' is missing.*variant.yaml"):
+        load_parameters([path])
+
+
+def test_unknown_key_is_an_error_with_a_suggestion(tmp_path):
+    path = _write_variant(tmp_path, "friction.theta_1", 0.9)
+    with pytest.raises(ParameterError, match=r"unknown parameter 'friction.theta_1'.*theta1"):
+        load_parameters([path])
+
+
+def test_bad_choice_and_bool_are_errors(tmp_path):
+    with pytest.raises(ParameterError, match=r"configuration.*rig, aircraft"):
+        load_parameters([_write_variant(tmp_path, "configuration", "truck")])
+    with pytest.raises(ParameterError, match=r"elements\.drag.*true or false"):
+        load_parameters([_write_variant(tmp_path, "elements.drag", "yes please")])
+
+
+@pytest.mark.parametrize(("text", "fragment"), [
+    ("not: [valid", "not valid YAML"),
+    ("- just\n- a list\n", "not a ROS 2 params file"),
+    ("plant:\n  params: {}\n", "no 'ros__parameters'"),
+])
+def test_malformed_file_is_a_one_line_error(tmp_path, text, fragment):
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    with pytest.raises(ParameterError, match=fragment) as error:
+        load_parameters([path])
+    assert "\n" not in str(error.value)
+
+
+def test_missing_file_is_named(tmp_path):
+    with pytest.raises(ParameterError, match=r"nowhere\.yaml: cannot read"):
+        load_parameters([tmp_path / "nowhere.yaml"])
+
+
+def test_overlay_switches_to_aircraft_and_keeps_the_rest(reference):
+    aircraft = load_parameters([REFERENCE, default_config_dir() / "aircraft.yaml"])
+    assert aircraft.configuration == "aircraft"
+    assert aircraft.number("drag.coeff_n_s2_per_m2") == 0.7
+    assert aircraft.number("friction.theta1") == reference.number("friction.theta1")
+
+
+def test_ros_style_exponent_is_read_as_a_number(tmp_path):
+    path = tmp_path / "overlay.yaml"
+    path.write_text("/**:\n  ros__parameters:\n    gear_walk:\n      stiffness_n_m_per_rad: 7e5\n")
+    params = load_parameters([REFERENCE, path])
+    assert params.number("gear_walk.stiffness_n_m_per_rad") == 7e5
+
+
+def test_sections_of_other_nodes_are_ignored(tmp_path):
+    path = tmp_path / "with_controller.yaml"
+    path.write_text("antiskid_controller:\n  ros__parameters:\n    type: slip\n")
+    assert load_parameters([REFERENCE, path]).number("friction.theta1") == 0.95
+
+
+def test_written_file_loads_back_identically(tmp_path, reference):
+    changed = reference.replace({"friction.theta1": 0.8123456789}).without("gear_walk")
+    changed.to_yaml(tmp_path / "out.yaml")
+    again = load_parameters([tmp_path / "out.yaml"])
+    assert np.array_equal(again.vector(), changed.vector())
+
+
+def test_overrides_and_without_are_validated(reference):
+    with pytest.raises(ParameterError, match="must not be negative"):
+        reference.replace({"wheel.inertia_kg_m2": -1.0})
+    with pytest.raises(ParameterError, match="unknown element 'tyre_wear'"):
+        reference.without("tyre_wear")
+    assert parse_assignment("friction.theta1=0.8") == ("friction.theta1", 0.8)
+    with pytest.raises(ParameterError, match="KEY=VALUE"):
+        parse_assignment("friction.theta1")
+
+
+def test_every_spec_has_a_unit_and_description():
+    assert len({s.key for s in SPECS}) == len(SPECS)
+    assert all(s.unit and s.description for s in SPECS)

@@ -23,6 +23,10 @@ demo: $(STAMP)
 	$(BIN)/landing-gear-sim simulate --pressure-bar 45 -o out/brake_const_45bar.csv
 	$(BIN)/landing-gear-sim simulate --profile osc-low -o out/brake_osc_low.csv
 	$(BIN)/landing-gear-sim bode -o out/bode.png
+	rm -rf out/campaign
+	$(BIN)/landing-gear-sim campaign out/campaign --seed 1
+	$(BIN)/landing-gear-sim identify out/campaign -o out/calibrated.yaml
+	$(BIN)/landing-gear-sim validate out/campaign --config out/calibrated.yaml --report out/validation
 
 lint: $(STAMP)
 	$(BIN)/ruff check landing_gear_sim antiskid msg_tools test bench
@@ -32,6 +36,7 @@ test: lint
 
 bench: $(STAMP)
 	$(BIN)/python bench/run.py
+	$(BIN)/python bench/identify.py
 
 clean:
 	rm -rf $(VENV) out build install log .pytest_cache

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from msg_tools.csv_io import Mapping
 from msg_tools.errors import RunFormatError
 
 from . import scenario as sc
@@ -163,6 +164,138 @@ def cmd_params(args: argparse.Namespace) -> int:
     return 0
 
 
+def _mapping(args: argparse.Namespace) -> Mapping | None:
+    from msg_tools.csv_io import read_mapping
+
+    return read_mapping(args.mapping) if getattr(args, "mapping", None) else None
+
+
+def _write_atomically(path: Path, write: Callable[[Path], None]) -> None:
+    """Write via a temporary file so a failure never leaves a half-written ``path``."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".part")
+    write(tmp)
+    tmp.replace(path)
+
+
+def cmd_identify(args: argparse.Namespace) -> int:
+    import json
+
+    from msg_tools.io import read_campaign
+
+    from .identify import identify
+    from .report import estimates_table, text_table
+
+    campaign = read_campaign(args.campaign, _mapping(args))
+    for problem in campaign.problems:
+        _progress(f"skipped: {problem}")
+    started = time.perf_counter()
+    result = identify(campaign.runs, _params(args), args.fix_theta3, _progress)
+    for name, kind in result.classes.items():
+        print(f"  {name:28s} {kind}")
+    for problem in result.problems:
+        print(f"  note: {problem}")
+    if not result.estimates:
+        raise LandingGearSimError(f"{args.campaign}: no identification step could run; "
+                                  f"nothing written")
+    print(text_table(["parameter", "value", "1-sigma", "method", "runs"],
+                     estimates_table(result.estimates)))
+    _write_atomically(args.output, result.params.to_yaml)
+    evidence = {"campaign": str(args.campaign), "classes": result.classes,
+                "problems": [*campaign.problems, *result.problems],
+                "estimates": [{"key": e.key, "value": e.value, "std": e.std,
+                               "method": e.method, "runs": list(e.runs)}
+                              for e in result.estimates]}
+    sidecar = args.output.with_suffix(".identification.json")
+    _write_atomically(sidecar, lambda p: p.write_text(json.dumps(evidence, indent=1)))
+    print(f"identified in {time.perf_counter() - started:.1f} s")
+    print(f"params:   {args.output}\nevidence: {sidecar}")
+    return 0
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    from msg_tools.io import read_campaign
+
+    from .identify import _braking, friction_samples
+    from .report import (
+        html_image,
+        html_table,
+        plot_friction,
+        plot_overlay,
+        scores_table,
+        text_table,
+        write_html,
+    )
+    from .validate import CHANNELS, validate
+
+    campaign = read_campaign(args.campaign, _mapping(args))
+    params = _params(args)
+    _progress(f"simulating {len(campaign.runs)} runs with their measured inputs")
+    comparisons = validate(campaign.runs, params)
+    header = ["run", "kind", *(c.split("_")[0] + " fit %" for c in CHANNELS)]
+    rows = scores_table(comparisons)
+    print(text_table(header, rows))
+    report = args.report
+    sections = [("Model", html_table(["parameters from"], [[", ".join(params.sources)]])),
+                ("Fit per run and channel", html_table(header, rows))]
+    braking = [c.measured for c in comparisons if c.kind.startswith("brake")]
+    if braking:
+        slip, mu = friction_samples([_braking(r, params) for r in braking], params)
+        figure = plot_friction(slip, mu, params, report / "friction.png")
+        sections.append(("Friction curve", html_image(figure, report)))
+    for c in comparisons:
+        figure = plot_overlay(c, report / f"{c.measured.name}.png")
+        sections.append((f"{c.measured.name}", html_image(figure, report)))
+    page = write_html(report / "index.html", f"Validation of {args.campaign}", sections)
+    print(f"report: {page}")
+    return 0
+
+
+def cmd_compare(args: argparse.Namespace) -> int:
+    from msg_tools.io import read_run
+
+    from .report import plot_overlay, text_table
+    from .validate import compare
+
+    measured, simulated = read_run(args.measured, _mapping(args)), read_run(args.simulated)
+    comparison = compare(measured, simulated)
+    rows = [[channel, f"{s.fit_percent:.2f}", f"{s.rmse:.4g}", f"{s.max_error:.4g}"]
+            for channel, s in comparison.scores.items()]
+    print(text_table(["channel (SI)", "fit %", "RMSE", "max |error|"], rows))
+    print(f"plot: {plot_overlay(comparison, args.plot)}")
+    return 0
+
+
+def cmd_campaign(args: argparse.Namespace) -> int:
+    from .campaign import GENERATING_FILE, generate_campaign, rig_like
+
+    if args.output.exists() and any(args.output.iterdir()):
+        raise LandingGearSimError(f"{args.output}: exists and is not empty, not overwriting")
+    rig = rig_like(_params(args), np.random.default_rng(args.seed), args.deviation)
+    _progress(f"simulating a synthetic campaign (seed {args.seed}, datasheet "
+              f"±{100 * args.deviation:g} %)")
+    for path in generate_campaign(args.output, rig, args.seed):
+        print(f"  {path}")
+    print(f"generating parameters (for checks only): {args.output / GENERATING_FILE}")
+    return 0
+
+
+def cmd_convert(args: argparse.Namespace) -> int:
+    from msg_tools.bag_io import write_bag
+    from msg_tools.csv_io import write_csv
+    from msg_tools.io import read_run
+
+    run = read_run(args.input, _mapping(args))
+    if args.output.exists():
+        raise LandingGearSimError(f"{args.output}: exists already, not overwriting")
+    if args.output.suffix == ".csv":
+        write_csv(run, args.output)
+    else:
+        write_bag(run, args.output, args.storage)
+    print(f"{args.input} -> {args.output} ({len(run)} samples)")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog=PROG, description="Landing-gear anti-skid rig "
                                      "digital twin: simulate, analyse, compare.")
@@ -199,6 +332,43 @@ def build_parser() -> argparse.ArgumentParser:
     bode.add_argument("--fmax", type=float, default=100.0)
     bode.add_argument("-o", "--output", type=Path, default=Path("out/bode.png"))
     bode.set_defaults(func=cmd_bode)
+
+    ident = sub.add_parser("identify", help="calibrate the model on a campaign folder")
+    ident.add_argument("campaign", type=Path, help="folder of runs (CSV files, bags)")
+    _add_params_arguments(ident)
+    ident.add_argument("-o", "--output", type=Path, default=Path("out/calibrated.yaml"))
+    ident.add_argument("--fix-theta3", action="store_true", help="keep Burckhardt theta3")
+    ident.add_argument("--mapping", type=Path, help="column-mapping file for the CSVs")
+    ident.set_defaults(func=cmd_identify)
+
+    val = sub.add_parser("validate", help="simulate a campaign with its inputs; fit report")
+    val.add_argument("campaign", type=Path)
+    _add_params_arguments(val)
+    val.add_argument("--report", type=Path, default=Path("out/validation"))
+    val.add_argument("--mapping", type=Path, help="column-mapping file for the CSVs")
+    val.set_defaults(func=cmd_validate)
+
+    cmp_ = sub.add_parser("compare", help="fit per channel of a simulated vs a measured run")
+    cmp_.add_argument("measured", type=Path)
+    cmp_.add_argument("simulated", type=Path)
+    cmp_.add_argument("--plot", type=Path, default=Path("out/compare.png"))
+    cmp_.add_argument("--mapping", type=Path, help="column-mapping file for MEASURED")
+    cmp_.set_defaults(func=cmd_compare)
+
+    gen = sub.add_parser("campaign", help="generate a synthetic rig campaign (own generator)")
+    gen.add_argument("output", type=Path, help="new folder for the runs")
+    _add_params_arguments(gen)
+    gen.add_argument("--seed", type=int, default=1)
+    gen.add_argument("--deviation", type=float, default=0.03,
+                     help="largest relative deviation of the rig from the datasheet")
+    gen.set_defaults(func=cmd_campaign)
+
+    conv = sub.add_parser("convert", help="convert a run between CSV and rosbag2")
+    conv.add_argument("input", type=Path)
+    conv.add_argument("output", type=Path, help="*.csv, or a bag folder")
+    conv.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
+    conv.add_argument("--mapping", type=Path, help="column-mapping file for a CSV input")
+    conv.set_defaults(func=cmd_convert)
 
     show = sub.add_parser("params", help="show (or write) the effective parameter set")
     _add_params_arguments(show)

@@ -27,7 +27,7 @@ from .plant import (
     plant_step,
     record,
 )
-from .scenario import Scenario
+from .scenario import Scenario, held_to_logged
 
 STOP_REASONS = ("end of input", "stop speed reached")
 
@@ -99,7 +99,7 @@ class SimulationResult:
 
         return Run(
             name=self.scenario.name, source="simulation", time_s=self.time_s.copy(),
-            current_a=self.current_a.copy(),
+            current_a=held_to_logged(self.current_a),
             pressure_pa=sensed(self.pressure_pa, "sensors.pressure_noise_pa"),
             wheel_speed_rad_s=sensed(self.wheel_speed_rad_s, "sensors.speed_noise_rad_s"),
             flywheel_speed_rad_s=sensed(self.speed_m_s / p.number("flywheel.radius_m"),

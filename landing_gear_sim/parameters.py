@@ -197,7 +197,8 @@ class RigParameters:
             *parents, leaf = spec.key.split(".")
             for part in parents:
                 section = section.setdefault(part, {})
-            section[leaf] = self.values[spec.key]
+            value = self.values[spec.key]
+            section[leaf] = float(value) if spec.kind == "float" else value  # type: ignore[arg-type]
         text = yaml.safe_dump({node: {"ros__parameters": nested}}, sort_keys=False)
         Path(path).write_text(text)
 

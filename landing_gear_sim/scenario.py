@@ -122,6 +122,24 @@ def steps_then_sweep() -> Profile:
     return lambda t: np.where(t < t_sweep, stair(t), sweep(t - t_sweep))
 
 
+def logged_to_held(current_logged_a: np.ndarray) -> np.ndarray:
+    """Model input from a logged current.
+
+    In a run log (CSV row, bag sample) the current at t_k is the command in force
+    over the interval that *ends* at t_k, so the pressure sampled at t_k already
+    reflects it (rig loggers and the example campaigns follow this). The model
+    holds sample k over [t_k, t_{k+1}): shift by one sample.
+    """
+    logged = np.asarray(current_logged_a, dtype=float)
+    return np.concatenate([logged[1:], logged[-1:]])
+
+
+def held_to_logged(current_held_a: np.ndarray) -> np.ndarray:
+    """Inverse of :func:`logged_to_held`: the current as a run log shows it."""
+    held = np.asarray(current_held_a, dtype=float)
+    return np.concatenate([held[:1], held[:-1]])
+
+
 def from_samples(time_s: np.ndarray, current_a: np.ndarray, name: str = "file") -> Profile:
     """A recorded current, held between samples (zero-order hold), last value after the end."""
     times = np.asarray(time_s, dtype=float)
@@ -143,7 +161,7 @@ def from_file(path: Path) -> tuple[Profile, float]:
     from msg_tools.csv_io import read_csv  # run I/O lives in msg_tools
 
     run = read_csv(Path(path))
-    profile = from_samples(run.time_s, run.current_a, str(path))
+    profile = from_samples(run.time_s, logged_to_held(run.current_a), str(path))
     return profile, float(run.time_s[-1] - run.time_s[0]) + 1.0 / run.rate_hz
 
 

@@ -10,6 +10,7 @@ from rosbags.rosbag2 import Reader, Writer
 from rosbags.rosbag2.enums import StoragePlugin
 from rosbags.typesys import Stores, get_typestore
 
+from .checks import check_plausible
 from .contract import (
     ATMOSPHERE_PA,
     TOPIC_CURRENT,
@@ -111,12 +112,14 @@ def read_bag(path: Path, name: str | None = None) -> Run:
 
     current_times, current_msgs = series[TOPIC_CURRENT]
     held = np.searchsorted(current_times, base + 1e-9, side="right") - 1
-    current = np.array([m.data for m in current_msgs])[np.clip(held, 0, None)]
-    return Run(
-        name=name or path.name, source=str(path), time_s=base, current_a=current,
-        pressure_pa=on_base(TOPIC_PRESSURE, lambda m: m.fluid_pressure - ATMOSPHERE_PA),
-        wheel_speed_rad_s=on_base(TOPIC_WHEEL, lambda m: m.velocity[0]),
-        flywheel_speed_rad_s=on_base(TOPIC_FLYWHEEL, lambda m: m.velocity[0]),
-        vertical_load_n=on_base(TOPIC_WRENCH, lambda m: m.wrench.force.z),
-        longitudinal_force_n=on_base(TOPIC_WRENCH, lambda m: m.wrench.force.x),
-    )
+    fields = {
+        "time_s": base,
+        "current_a": np.array([m.data for m in current_msgs])[np.clip(held, 0, None)],
+        "pressure_pa": on_base(TOPIC_PRESSURE, lambda m: m.fluid_pressure - ATMOSPHERE_PA),
+        "wheel_speed_rad_s": on_base(TOPIC_WHEEL, lambda m: m.velocity[0]),
+        "flywheel_speed_rad_s": on_base(TOPIC_FLYWHEEL, lambda m: m.velocity[0]),
+        "vertical_load_n": on_base(TOPIC_WRENCH, lambda m: m.wrench.force.z),
+        "longitudinal_force_n": on_base(TOPIC_WRENCH, lambda m: m.wrench.force.x),
+    }
+    check_plausible(fields, str(path))
+    return Run(name=name or path.name, source=str(path), **fields)

@@ -12,7 +12,11 @@ CSV_COLUMNS: tuple[str, ...] = (
     "time_s", "current_ref_A", "brake_pressure_bar", "wheel_speed_rad_s",
     "flywheel_speed_rad_s", "vertical_load_N", "longitudinal_force_N",
 )
-"""Contract CSV header names, in the order we write them (readers accept any order)."""
+"""Contract CSV header names, in the order we write them (readers accept any order).
+
+The current of a row is the command in force over the sample interval that ends at that
+row's time (the row's pressure already reflects it); the same holds for a bag's
+current_ref at its log time."""
 
 CSV_SCALE_TO_SI: dict[str, float] = {
     "time_s": 1.0, "current_ref_A": 1.0, "brake_pressure_bar": PA_PER_BAR,

@@ -1,0 +1,49 @@
+"""Plausibility checks on a run: catch unit mix-ups and broken logs early, with a clear message."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import RunFormatError
+
+PLAUSIBLE_MAX: dict[str, tuple[float, str, float]] = {
+    "current_a": (20.0, "A", 1.0),
+    "pressure_pa": (500e5, "bar", 1e5),
+    "wheel_speed_rad_s": (5000.0, "rad/s", 1.0),
+    "flywheel_speed_rad_s": (2000.0, "rad/s", 1.0),
+    "vertical_load_n": (2e6, "N", 1.0),
+    "longitudinal_force_n": (2e6, "N", 1.0),
+}
+"""Largest |value| a landing-gear rig can produce, per field (SI, display unit, factor)."""
+
+MAX_GAP_SAMPLES = 5.0  # a step longer than this many nominal periods is a gap in the log
+
+
+def check_plausible(fields: dict[str, np.ndarray], where: str) -> None:
+    """Raise if a signal is out of any physical range (e.g. Pa declared as bar) or has gaps."""
+    for name, (limit, unit, factor) in PLAUSIBLE_MAX.items():
+        peak = float(np.max(np.abs(fields[name])))
+        if peak > limit:
+            raise RunFormatError(
+                f"{where}: {name} reaches {peak / factor:.4g} {unit}, implausible for a rig "
+                f"(max {limit / factor:g} {unit}); is the unit wrong? declare it in a "
+                "column-mapping file")
+    check_time(fields["time_s"], where)
+
+
+def check_time(time_s: np.ndarray, where: str) -> None:
+    """Raise on non-increasing time, duplicated stamps or gaps."""
+    steps = np.diff(time_s)
+    if time_s.size < 2:
+        raise RunFormatError(f"{where}: fewer than 2 samples")
+    bad = np.flatnonzero(steps <= 0)
+    if bad.size:
+        kind = "duplicated" if steps[bad[0]] == 0 else "decreasing"
+        raise RunFormatError(f"{where}: time is not strictly increasing ({kind} time "
+                             f"{time_s[bad[0] + 1]:.6g} s at sample {bad[0] + 1})")
+    nominal = float(np.median(steps))
+    gaps = np.flatnonzero(steps > MAX_GAP_SAMPLES * nominal)
+    if gaps.size:
+        k = gaps[0]
+        raise RunFormatError(f"{where}: gap of {steps[k]:.4g} s in the log after "
+                             f"t = {time_s[k]:.6g} s (nominal period {nominal:.3g} s)")

@@ -1,0 +1,136 @@
+"""Identification and validation on a campaign generated with parameters the code never sees."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import numpy as np
+import pytest
+
+from landing_gear_sim.campaign import DEVIATING, generate_campaign, rig_like
+from landing_gear_sim.cli import main
+from landing_gear_sim.identify import classify, identify
+from landing_gear_sim.parameters import load_parameters
+from landing_gear_sim.validate import validate
+from msg_tools.io import read_campaign
+
+SEED = 11  # the hidden rig: datasheet values off by up to ±3 %, never shown to identify()
+
+
+@pytest.fixture(scope="module")
+def hidden_rig(reference):
+    return rig_like(reference, np.random.default_rng(SEED), deviation=0.03)
+
+
+@pytest.fixture(scope="module")
+def campaign_dir(tmp_path_factory, hidden_rig):
+    folder = tmp_path_factory.mktemp("campaign")
+    generate_campaign(folder, hidden_rig, SEED)
+    (folder / "generating-parameters.yaml").rename(folder.parent / f"hidden-{SEED}.yaml")
+    return folder
+
+
+@pytest.fixture(scope="module")
+def identified(campaign_dir, reference):
+    return identify(read_campaign(campaign_dir).runs, reference)
+
+
+def test_runs_are_classified_from_their_signals(identified):
+    assert identified.classes == {
+        "actuator_ramp": "actuator_ramp", "actuator_steps_sweep": "actuator_dynamic",
+        **{f"brake_const_{b}bar": "brake_constant" for b in (10, 20, 30, 40)},
+        "brake_osc_high": "brake_oscillating", "brake_osc_low": "brake_oscillating"}
+
+
+def test_identification_recovers_the_hidden_rig(identified, hidden_rig):
+    found = {e.key: e for e in identified.estimates}
+    for key in DEVIATING:
+        estimate = found[key]
+        assert estimate.value == pytest.approx(hidden_rig.number(key), rel=0.05), (SEED, key)
+        assert 0 < estimate.std < abs(estimate.value) and estimate.runs
+        # the stated uncertainty is honest: the truth lies within 4 σ
+        assert abs(estimate.value - hidden_rig.number(key)) < 4 * estimate.std + 1e-3 * abs(
+            estimate.value), (key, estimate)
+    for key in ("actuator.natural_frequency_hz", "actuator.damping_ratio",
+                "brake.gain_n_m_per_pa", "friction.theta1"):
+        assert found[key].value == pytest.approx(hidden_rig.number(key), rel=0.01), (SEED, key)
+
+
+def test_calibrated_model_fits_the_oscillating_runs(identified, campaign_dir):
+    for comparison in validate(read_campaign(campaign_dir).runs, identified.params):
+        if comparison.kind == "brake_oscillating":
+            assert comparison.scores["wheel_speed_rad_s"].fit_percent >= 95.0
+            assert comparison.scores["pressure_pa"].fit_percent >= 95.0
+
+
+def test_datasheet_model_fits_worse_than_the_calibrated_one(identified, campaign_dir, reference):
+    runs = [r for r in read_campaign(campaign_dir).runs if r.name == "brake_osc_low"]
+    before = validate(runs, reference)[0].scores["wheel_speed_rad_s"].fit_percent
+    after = validate(runs, identified.params)[0].scores["wheel_speed_rad_s"].fit_percent
+    assert after > before
+
+
+def test_steps_without_their_runs_are_skipped_and_the_rest_runs(campaign_dir, reference,
+                                                                 tmp_path):
+    for run in campaign_dir.glob("brake_*.csv"):
+        shutil.copy(run, tmp_path / run.name)
+    result = identify(read_campaign(tmp_path).runs, reference)
+    assert any("valve static map: skipped" in p for p in result.problems)
+    assert any("actuator dynamics A(s): skipped" in p for p in result.problems)
+    assert {e.key for e in result.estimates} >= {"friction.theta1", "brake.gain_n_m_per_pa"}
+
+
+def test_fixing_theta3_keeps_it(identified, campaign_dir, reference):
+    result = identify(read_campaign(campaign_dir).runs, reference, fix_theta3=True)
+    assert result.params.number("friction.theta3") == reference.number("friction.theta3")
+
+
+def test_identify_cli_writes_params_and_evidence(campaign_dir, tmp_path, capsys, hidden_rig):
+    out = tmp_path / "calibrated.yaml"
+    assert main(["identify", str(campaign_dir), "-o", str(out)]) == 0
+    params = load_parameters([out])
+    assert params.number("brake.gain_n_m_per_pa") == pytest.approx(
+        hidden_rig.number("brake.gain_n_m_per_pa"), rel=0.01)
+    evidence = json.loads(out.with_suffix(".identification.json").read_text())
+    assert {e["key"] for e in evidence["estimates"]} >= set(DEVIATING)
+    assert main(["validate", str(campaign_dir), "--config", str(out),
+                 "--report", str(tmp_path / "report")]) == 0
+    page = (tmp_path / "report" / "index.html").read_text()
+    assert "brake_osc_low.png" in page and "friction.png" in page
+    capsys.readouterr()
+
+
+def test_failed_identify_overwrites_nothing(tmp_path, capsys):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    (empty / "broken.csv").write_text("time_s,foo\n0,1\n")
+    out = tmp_path / "calibrated.yaml"
+    out.write_text("keep me\n")
+    assert main(["identify", str(empty), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "no readable run" in err and "broken.csv" in err
+    assert out.read_text() == "keep me\n"
+
+
+def test_classify_tells_actuator_only_from_braking(campaign_dir):
+    runs = {r.name: r for r in read_campaign(campaign_dir).runs}
+    assert classify(runs["actuator_ramp"]).startswith("actuator")
+    assert classify(runs["brake_const_30bar"]) == "brake_constant"
+
+
+def test_generated_campaign_is_reproducible(tmp_path, reference):
+    rig = rig_like(reference, np.random.default_rng(1))
+    a, b = tmp_path / "a", tmp_path / "b"
+    generate_campaign(a, rig, 1)
+    generate_campaign(b, rig, 1)
+    assert (a / "brake_osc_low.csv").read_text() == (b / "brake_osc_low.csv").read_text()
+
+
+def test_campaign_cli_refuses_to_overwrite(tmp_path, capsys):
+    (tmp_path / "old").mkdir()
+    (tmp_path / "old" / "run.csv").write_text("x\n")
+    assert main(["campaign", str(tmp_path / "old")]) == 2
+    assert "not empty" in capsys.readouterr().err
+    assert main(["campaign", str(tmp_path / "new"), "--seed", "3"]) == 0
+    assert len(list((tmp_path / "new").glob("*.csv"))) == 8

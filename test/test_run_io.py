@@ -1,0 +1,152 @@
+"""Reading runs from other layouts and bad files: one clear message naming the file."""
+
+from __future__ import annotations
+
+import math
+import shutil
+
+import numpy as np
+import pytest
+
+from landing_gear_sim import scenario as sc
+from landing_gear_sim.cli import main
+from landing_gear_sim.integrate import simulate
+from msg_tools.bag_io import write_bag
+from msg_tools.csv_io import format_csv, read_csv, read_mapping, write_csv
+from msg_tools.errors import RunFormatError
+from msg_tools.io import read_campaign, read_run, resample
+
+MAPPING = """
+time_s: {column: t_ms, unit: ms}
+current_ref_A: {column: I_valve, unit: mA}
+brake_pressure_bar: {column: p_brake, unit: psi}
+wheel_speed_rad_s: {column: n_wheel, unit: rpm}
+flywheel_speed_rad_s: {column: n_fly, unit: rpm}
+vertical_load_N: {column: Fz, unit: kN}
+longitudinal_force_N: {column: Fx, unit: kN}
+"""
+
+
+@pytest.fixture(scope="module")
+def run(reference):
+    params = reference.replace({"rig_test.max_duration_s": 3.0, "sensors.force_noise_n": 50.0})
+    return simulate(params, sc.rig_test(params, sc.oscillating(**sc.OSC_LOW))).to_run(3)
+
+
+@pytest.fixture()
+def csv_file(tmp_path, run):
+    path = tmp_path / "run.csv"
+    write_csv(run, path)
+    return path
+
+
+def test_mapped_layout_with_other_units_reads_as_the_contract(tmp_path, run):
+    rpm, psi = 2 * math.pi / 60, 6894.757293168361
+    columns = {"t_ms": run.time_s * 1e3, "I_valve": run.current_a * 1e3,
+               "p_brake": run.pressure_pa / psi, "n_wheel": run.wheel_speed_rad_s / rpm,
+               "n_fly": run.flywheel_speed_rad_s / rpm, "Fz": run.vertical_load_n / 1e3,
+               "Fx": run.longitudinal_force_n / 1e3}
+    path = tmp_path / "other.csv"
+    table = np.column_stack(list(columns.values()))
+    np.savetxt(path, table, delimiter=",", header=",".join(columns), comments="", fmt="%.15g")
+    (tmp_path / "map.yaml").write_text(MAPPING)
+    back = read_csv(path, mapping=read_mapping(tmp_path / "map.yaml"))
+    assert np.allclose(back.pressure_pa, run.pressure_pa, rtol=1e-12, atol=1e-6)
+    assert np.allclose(back.wheel_speed_rad_s, run.wheel_speed_rad_s, rtol=1e-12, atol=1e-9)
+    assert np.allclose(back.time_s, run.time_s, rtol=1e-12, atol=1e-12)
+
+
+def test_mapping_with_an_unknown_unit_is_refused(tmp_path):
+    (tmp_path / "map.yaml").write_text(MAPPING.replace("unit: psi", "unit: atm"))
+    with pytest.raises(RunFormatError, match=r"unit 'atm' of brake_pressure_bar"):
+        read_mapping(tmp_path / "map.yaml")
+
+
+def test_pressure_in_pa_declared_as_bar_is_caught(tmp_path, run):
+    text = format_csv(run).splitlines()
+    header = text[0].split(",")
+    k = header.index("brake_pressure_bar")
+    rows = [row.split(",") for row in text[1:]]
+    for row in rows:
+        row[k] = repr(float(row[k]) * 1e5)
+    path = tmp_path / "pa.csv"
+    path.write_text("\n".join([text[0], *(",".join(r) for r in rows)]) + "\n")
+    with pytest.raises(RunFormatError, match=r"pa\.csv: pressure_pa reaches .* bar, implausible"):
+        read_csv(path)
+
+
+@pytest.mark.parametrize(("edit", "fragment"), [
+    (lambda rows: rows[:100] + rows[150:], "gap of"),
+    (lambda rows: [*rows[:10], rows[10], *rows[10:]], "duplicated time"),
+])
+def test_broken_time_base_is_named(tmp_path, csv_file, edit, fragment):
+    lines = csv_file.read_text().splitlines()
+    bad = tmp_path / "bad.csv"
+    bad.write_text("\n".join([lines[0], *edit(lines[1:])]) + "\n")
+    with pytest.raises(RunFormatError, match=fragment) as error:
+        read_csv(bad)
+    assert str(bad) in str(error.value)
+
+
+def test_bag_missing_a_topic_is_named(tmp_path, run):
+    from rosbags.rosbag2 import Writer
+
+    from msg_tools.bag_io import BAG_VERSION, TYPESTORE, contract_messages
+    from msg_tools.contract import TOPIC_TYPES, TOPIC_WRENCH
+
+    path = tmp_path / "partial"
+    with Writer(path, version=BAG_VERSION) as writer:
+        connections = {t: writer.add_connection(t, m, typestore=TYPESTORE)
+                       for t, m in TOPIC_TYPES.items() if t != TOPIC_WRENCH}
+        for k in range(20):
+            for topic, message in contract_messages(run, k).items():
+                if topic in connections:
+                    writer.write(connections[topic], k * 1_000_000,
+                                 TYPESTORE.serialize_cdr(message, TOPIC_TYPES[topic]))
+    with pytest.raises(RunFormatError, match=r"partial: bag has no messages on /rig/load_cell"):
+        read_run(path)
+
+
+@pytest.mark.parametrize("damage", ["empty", "truncated"])
+def test_empty_or_truncated_bag_is_an_error_not_a_traceback(tmp_path, run, damage):
+    path = tmp_path / "bag"
+    write_bag(run, path, "sqlite3")
+    database = next(path.glob("*.db3"))
+    if damage == "empty":
+        database.write_bytes(b"")
+    else:
+        database.write_bytes(database.read_bytes()[:2048])
+    with pytest.raises(RunFormatError, match="bag"):
+        read_run(path)
+
+
+def test_campaign_skips_a_bad_file_and_keeps_the_rest(tmp_path, csv_file):
+    shutil.copy(csv_file, tmp_path / "good.csv")
+    (tmp_path / "bad.csv").write_text("time_s\n1\n")
+    campaign = read_campaign(tmp_path)
+    assert [r.name for r in campaign.runs] == ["good", "run"]
+    assert len(campaign.problems) == 1 and "bad.csv" in campaign.problems[0]
+
+
+def test_convert_round_trip_csv_bag_csv_is_exact(tmp_path, csv_file, capsys):
+    assert main(["convert", str(csv_file), str(tmp_path / "bag")]) == 0
+    assert main(["convert", str(tmp_path / "bag"), str(tmp_path / "back.csv")]) == 0
+    assert (tmp_path / "back.csv").read_text() == csv_file.read_text()
+    assert main(["convert", str(csv_file), str(tmp_path / "back.csv")]) == 2
+    assert "exists already" in capsys.readouterr().err
+
+
+def test_resample_puts_a_run_on_a_uniform_base(run):
+    jittered = run.__class__(**{**run.__dict__, "time_s": run.time_s + np.r_[
+        0, np.full(len(run) - 2, 2e-5), 0]})
+    uniform = resample(jittered, 1000.0)
+    assert np.allclose(np.diff(uniform.time_s), 1e-3)
+    assert np.allclose(uniform.wheel_speed_rad_s, run.wheel_speed_rad_s[:len(uniform)],
+                       atol=0.05)
+
+
+def test_compare_cli_scores_a_simulation_against_itself(tmp_path, csv_file, capsys):
+    assert main(["compare", str(csv_file), str(csv_file), "--plot",
+                 str(tmp_path / "c.png")]) == 0
+    out = capsys.readouterr().out
+    assert "wheel_speed_rad_s" in out and "100.00" in out

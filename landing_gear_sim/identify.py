@@ -412,16 +412,27 @@ def refine_friction(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
         flywheel = simulated.flywheel_speed_rad_s[window] - run.flywheel_speed_rad_s[window]
         return (wheel - ratio * flywheel)[::5]
 
-    def residual(theta: np.ndarray) -> np.ndarray:
+    def residual(theta: np.ndarray, chosen: Sequence[int]) -> np.ndarray:
         trial = p.replace(dict(zip(keys, theta * start, strict=True)), "identify")
-        return np.concatenate([slip_error(r, w, trial)
-                               for r, w in zip(runs, windows, strict=True)])
+        return np.concatenate([slip_error(runs[i], windows[i], trial) for i in chosen])
 
-    fit = least_squares(residual, np.ones(3), diff_step=1e-4)
-    std = _covariance_std(fit, 3) * start
+    fit = least_squares(lambda th: residual(th, range(len(runs))), np.ones(3), diff_step=1e-4)
+    std = np.maximum(_covariance_std(fit, 3), _jackknife_std(residual, fit.x, len(runs)))
     names = tuple(r.name for r in runs)
-    return [Estimate(k, float(v), float(sd), names, "output error on wheel vs flywheel speed")
-            for k, v, sd in zip(keys, fit.x * start, std, strict=True)]
+    return [Estimate(k, float(v), float(sd), names,
+                     "output error on wheel vs flywheel speed; σ: max(residual, jackknife)")
+            for k, v, sd in zip(keys, fit.x * start, std * start, strict=True)]
+
+
+def _jackknife_std(residual: Callable[[np.ndarray, Sequence[int]], np.ndarray],
+                   solution: np.ndarray, n_runs: int) -> np.ndarray:
+    """Leave-one-run-out spread of the fit: run-to-run variability the residuals hide."""
+    if n_runs < 3:
+        return np.zeros_like(solution)
+    fits = [least_squares(lambda th, i=i: residual(th, [j for j in range(n_runs) if j != i]),
+                          solution, diff_step=1e-4).x for i in range(n_runs)]
+    spread = np.asarray(fits) - np.mean(fits, axis=0)
+    return np.sqrt((n_runs - 1) / n_runs * np.sum(spread ** 2, axis=0))
 
 
 # --- driver -----------------------------------------------------------------------------

@@ -32,7 +32,7 @@ from msg_tools.run import Run
 
 from . import elements as el
 from .parameters import RigParameters
-from .plant import actuator_matrices, actuator_step
+from .plant import actuator_matrices, actuator_state, actuator_step
 from .scenario import logged_to_held
 
 FILTER_HZ = 20.0  # zero-phase low-pass before differentiating speeds
@@ -149,7 +149,7 @@ def fit_static_map(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
 @njit(cache=True)
 def _actuator_response(p, matrices, current):
     """Pressure for a held current sequence, starting in steady state at the first current."""
-    xa = np.zeros(2)
+    xa = actuator_state(matrices)
     xa[0] = actuator_step(p, matrices, xa, current[0])
     for _ in range(100000):  # settle on the first level (A(s) is stable)
         before = xa[0]

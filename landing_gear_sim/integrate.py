@@ -22,6 +22,7 @@ from .plant import (
     N_STATES,
     SPEED,
     actuator_matrices,
+    actuator_state,
     actuator_step,
     loading_step,
     plant_step,
@@ -37,7 +38,7 @@ def run_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed,
     """Simulate one run; fill ``out`` (n, N_CHANNELS); return (rows written, stop code)."""
     x = np.zeros(N_STATES)
     x[SPEED] = initial_speed if contact else 0.0
-    xa = np.zeros(2)
+    xa = actuator_state(matrices)
     xl = np.zeros(1)
     work = np.zeros((5, N_STATES))
     pressure, load = 0.0, 0.0
@@ -85,10 +86,17 @@ class SimulationResult:
     def __len__(self) -> int:
         return int(self.data.shape[0])
 
+    def _pressure_offset_pa(self) -> float:
+        if not self.params.has("pressure_sensor_offset"):
+            return 0.0
+        return self.params.number("sensors.pressure_offset_pa")
+
     def to_run(self, noise_seed: int | None = None) -> Run:
         """The run as the rig's sensors would log it (data contract), with sensor noise.
 
-        Noise std comes from ``sensors.*``; ``noise_seed`` makes it reproducible.
+        Noise std comes from ``sensors.*``; ``noise_seed`` makes it reproducible. The
+        pressure transducer reads ``sensors.pressure_offset_pa`` high when the
+        ``pressure_sensor_offset`` element is on.
         """
         rng = np.random.default_rng(noise_seed)
         p = self.params
@@ -100,7 +108,8 @@ class SimulationResult:
         return Run(
             name=self.scenario.name, source="simulation", time_s=self.time_s.copy(),
             current_a=held_to_logged(self.current_a),
-            pressure_pa=sensed(self.pressure_pa, "sensors.pressure_noise_pa"),
+            pressure_pa=sensed(self.pressure_pa + self._pressure_offset_pa(),
+                               "sensors.pressure_noise_pa"),
             wheel_speed_rad_s=sensed(self.wheel_speed_rad_s, "sensors.speed_noise_rad_s"),
             flywheel_speed_rad_s=sensed(self.speed_m_s / p.number("flywheel.radius_m"),
                                         "sensors.speed_noise_rad_s"),

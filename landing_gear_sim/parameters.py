@@ -21,8 +21,10 @@ import yaml
 
 from .errors import ParameterError
 
-ELEMENTS: tuple[str, ...] = ("gear_walk", "load_dependent_radius", "actuator_dynamics", "drag")
-"""Model elements that can be switched off (``elements.<name>: false``)."""
+ELEMENTS: tuple[str, ...] = ("gear_walk", "load_dependent_radius", "actuator_dynamics", "drag",
+                             "actuator_delay", "pressure_sensor_offset")
+"""Model elements that can be switched on or off (``elements.<name>``). The last ones are
+extensions the reference rig does not have (off in its file)."""
 
 CONFIGURATIONS: tuple[str, ...] = ("rig", "aircraft")
 
@@ -36,6 +38,7 @@ class ParamSpec:
     description: str
     kind: str = "float"  # "float", "bool" or "choice"
     positive: bool = False  # strictly > 0 (else >= 0)
+    signed: bool = False  # may be negative (an offset)
     choices: tuple[str, ...] = ()
 
 
@@ -76,6 +79,8 @@ SPECS: tuple[ParamSpec, ...] = (
     _f("actuator.gain", "-", "A(s) static gain"),
     _f("actuator.natural_frequency_hz", "Hz", "A(s) natural frequency"),
     _f("actuator.damping_ratio", "-", "A(s) damping ratio"),
+    _f("actuator.delay_s", "s", "transport delay current -> pressure (actuator_delay)",
+       positive=False),
     _f("loading.static_load_n", "N", "vertical load at zero speed F_z0"),
     _f("loading.lift_coeff_n_s2_per_m2", "N s^2/m^2", "lift coefficient k_L", positive=False),
     _f("loading.servo_time_constant_s", "s", "loading-device servo time constant"),
@@ -91,6 +96,8 @@ SPECS: tuple[ParamSpec, ...] = (
     _f("sensors.pressure_noise_pa", "Pa", "pressure transducer noise std", positive=False),
     _f("sensors.speed_noise_rad_s", "rad/s", "encoder noise std", positive=False),
     _f("sensors.force_noise_n", "N", "load-cell noise std", positive=False),
+    ParamSpec("sensors.pressure_offset_pa", "Pa",
+              "pressure transducer offset (pressure_sensor_offset)", signed=True),
     _f("simulation.output_rate_hz", "Hz", "output (and input hold) rate"),
 )
 
@@ -319,7 +326,7 @@ def _problem(spec: ParamSpec, value: Any) -> str | None:
         return f"must be a number [{spec.unit}], got {value!r}"
     if not math.isfinite(value):
         return f"must be finite, got {value!r}"
-    if value < 0:
+    if value < 0 and not spec.signed:
         return f"must not be negative, got {value!r} [{spec.unit}]"
     if spec.positive and value == 0:
         return f"must be > 0, got {value!r} [{spec.unit}]"

@@ -50,6 +50,7 @@ N_CHANNELS = len(CHANNELS)
 _ACT_GAIN = INDEX["actuator.gain"]
 _ACT_WN = INDEX["actuator.natural_frequency_hz"]
 _ACT_ZETA = INDEX["actuator.damping_ratio"]
+_ACT_DELAY = INDEX["actuator.delay_s"]
 
 
 @njit(cache=True)
@@ -134,33 +135,64 @@ def plant_step(p, x, pressure0, pressure1, load0, load1, step_s, work):
             x[OMEGA] = 0.0
 
 
-def actuator_matrices(params_vector: np.ndarray, step_s: float) -> np.ndarray:
-    """Exact zero-order-hold discretisation of A(s) over ``step_s``.
+def _zoh(a: np.ndarray, b: np.ndarray, span_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Φ = e^{A T}, Γ = ∫₀ᵀ e^{A s} ds B for an input held over ``span_s``."""
+    augmented = np.zeros((3, 3))
+    augmented[:2, :2], augmented[:2, 2] = a, b
+    m = scipy.linalg.expm(augmented * span_s)
+    return m[:2, :2], m[:2, 2]
 
-    Returns ``[Φ00, Φ01, Φ10, Φ11, Γ0, Γ1]`` for the state (pressure [Pa], rate [Pa/s])
-    driven by the static-map pressure held over the step.
+
+ACT_DELAY_STEPS = 8  # position of the whole-step delay in the actuator matrices
+
+
+def actuator_matrices(params_vector: np.ndarray, step_s: float) -> np.ndarray:
+    """Exact discretisation of A(s) with the held input delayed by ``actuator.delay_s``.
+
+    With the delay d = (m + f)·h, the input seen over step k is u_{k−m−1} for f·h,
+    then u_{k−m} for (1−f)·h, so x_{k+1} = Φ_h x_k + G0 u_{k−m} + G1 u_{k−m−1} with
+    G0 = Γ_{(1−f)h} and G1 = Φ_{(1−f)h} Γ_{fh}. Returns
+    ``[Φ00, Φ01, Φ10, Φ11, G0₀, G0₁, G1₀, G1₁, m]`` for the state (pressure [Pa],
+    rate [Pa/s]) driven by the static-map pressure.
     """
     p = params_vector
     wn = 2.0 * math.pi * p[_ACT_WN]
     a = np.array([[0.0, 1.0], [-wn * wn, -2.0 * p[_ACT_ZETA] * wn]])
     b = np.array([0.0, p[_ACT_GAIN] * wn * wn])
-    augmented = np.zeros((3, 3))
-    augmented[:2, :2], augmented[:2, 2] = a, b
-    m = scipy.linalg.expm(augmented * step_s)
-    return np.array([m[0, 0], m[0, 1], m[1, 0], m[1, 1], m[0, 2], m[1, 2]])
+    delay = p[_ACT_DELAY] if p[el.HAS_ACTUATOR_DELAY] else 0.0
+    steps = delay / step_s
+    whole = math.floor(steps + 1e-9)
+    fraction = steps - whole if steps - whole > 1e-9 else 0.0
+    phi, gamma = _zoh(a, b, step_s)
+    if fraction == 0.0:
+        g0, g1 = gamma, np.zeros(2)
+    else:
+        phi_late, g0 = _zoh(a, b, (1.0 - fraction) * step_s)
+        g1 = phi_late @ _zoh(a, b, fraction * step_s)[1]
+    return np.concatenate([phi.ravel(), g0, g1, [float(whole)]])
+
+
+@njit(cache=True)
+def actuator_state(matrices):
+    """Zero actuator state: pressure, rate, then the static pressures of recent steps."""
+    return np.zeros(2 + int(matrices[ACT_DELAY_STEPS]) + 2)
 
 
 @njit(cache=True)
 def actuator_step(p, matrices, xa, current_a):
-    """Advance the actuator state ``xa`` (2,) one step with ``current_a`` held; return P [Pa]."""
-    static = el.valve_static_pressure(p, current_a)
+    """Advance the actuator state ``xa`` one step with ``current_a`` held; return P [Pa]."""
+    for j in range(xa.size - 1, 2, -1):  # shift register of static-map pressures
+        xa[j] = xa[j - 1]
+    xa[2] = el.valve_static_pressure(p, current_a)
+    whole = int(matrices[ACT_DELAY_STEPS])
+    newer, older = xa[2 + whole], xa[3 + whole]
     if p[el.HAS_ACTUATOR_DYNAMICS] == 0.0:
-        xa[0], xa[1] = p[_ACT_GAIN] * static, 0.0
+        xa[0], xa[1] = p[_ACT_GAIN] * newer, 0.0
         return xa[0]
     m = matrices
     x0, x1 = xa[0], xa[1]
-    xa[0] = m[0] * x0 + m[1] * x1 + m[4] * static
-    xa[1] = m[2] * x0 + m[3] * x1 + m[5] * static
+    xa[0] = m[0] * x0 + m[1] * x1 + m[4] * newer + m[6] * older
+    xa[1] = m[2] * x0 + m[3] * x1 + m[5] * newer + m[7] * older
     return xa[0]
 
 

@@ -130,7 +130,7 @@ def test_stepping_the_blocks_one_by_one_equals_the_compiled_run(reference):
     expected = np.empty((current.size, plant.N_CHANNELS))
     run_kernel(p, matrices, current, h, True, 60.0, 0.0, expected)
 
-    x, xa, xl = np.zeros(plant.N_STATES), np.zeros(2), np.zeros(1)
+    x, xa, xl = np.zeros(plant.N_STATES), plant.actuator_state(matrices), np.zeros(1)
     x[plant.SPEED] = 60.0
     work, rows = np.zeros((5, plant.N_STATES)), np.empty_like(expected)
     pressure = load = 0.0

@@ -10,6 +10,7 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,6 +20,9 @@ from msg_tools.errors import RunFormatError
 from . import scenario as sc
 from .errors import LandingGearSimError
 from .parameters import ELEMENTS, SPECS, RigParameters, load_parameters, parse_assignment
+
+if TYPE_CHECKING:
+    from .integrate import SimulationResult
 
 PROG = "landing-gear-sim"
 
@@ -88,10 +92,7 @@ def _build_scenario(args: argparse.Namespace, params: RigParameters) -> sc.Scena
     return sc.actuator_test(params, profile, duration or 10.0, name, rate)
 
 
-def _summary(result: object) -> str:
-    from .integrate import SimulationResult
-
-    assert isinstance(result, SimulationResult)
+def _summary(result: SimulationResult) -> str:
     lines = [f"{result.scenario.name}: {len(result)} samples, {result.time_s[-1]:.3f} s "
              f"({result.stop_reason}); max pressure {result.pressure_pa.max() / 1e5:.2f} bar"]
     if result.scenario.contact:

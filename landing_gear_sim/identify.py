@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
@@ -70,7 +70,6 @@ class Identification:
     problems: tuple[str, ...] = ()
     frf: FrfEstimate | None = None
     friction_points: tuple[np.ndarray, np.ndarray] | None = None  # slip, μ samples
-    extras: dict[str, float] = field(default_factory=dict)
 
 
 # --- classification --------------------------------------------------------------------
@@ -456,9 +455,9 @@ def identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool = False,
         estimates.extend(new)
         params = params.replace({e.key: e.value for e in new}, "identify")
 
-    def step(name: str, needs: str, action: Callable[[], None]) -> None:
-        if not needs_met(needs):
-            problems.append(f"{name}: skipped, no {needs.replace('_', ' ')} run in the campaign")
+    def step(name: str, needs: list[Run], missing: str, action: Callable[[], None]) -> None:
+        if not needs:
+            problems.append(f"{name}: skipped, no {missing} run in the campaign")
             return
         say(f"identifying {name}")
         try:
@@ -466,25 +465,22 @@ def identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool = False,
         except (ValueError, np.linalg.LinAlgError) as exc:
             problems.append(f"{name}: failed ({exc})")
 
-    def needs_met(needs: str) -> bool:
-        return any(c.startswith(needs) for c in by_class) if needs.endswith("_") else bool(
-            by_class.get(needs))
+    ramps = by_class.get("actuator_ramp", [])
+    dynamic = by_class.get("actuator_dynamic", [])
+    braking_runs = [r for r in runs if classes[r.name].startswith("brake_")]
 
     def static_map() -> None:
-        adopt(fit_static_map(by_class["actuator_ramp"], params))
+        adopt(fit_static_map(ramps, params))
 
     def dynamics() -> None:
         nonlocal frf
-        found, frf = fit_actuator_dynamics(by_class["actuator_dynamic"], params)
+        found, frf = fit_actuator_dynamics(dynamic, params)
         adopt(found)
-
-    braking_runs = [r for r in runs if classes[r.name].startswith("brake_")]
 
     def braking() -> None:
         nonlocal points
-        prepared = [_braking(r, params) for r in braking_runs]
+        prepared = [_braking(r, params) for r in braking_runs]  # independent of what follows
         adopt([fit_unloaded_radius(prepared, params)])
-        prepared = [_braking(r, params) for r in braking_runs]
         adopt(fit_flywheel(prepared, params))
         adopt([fit_brake_gain(prepared, params)])
         points = friction_samples(prepared, params)
@@ -495,7 +491,7 @@ def identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool = False,
             estimates[:] = [e for e in estimates if not e.key.startswith("friction.")]
             adopt(refined)
 
-    step("valve static map", "actuator_ramp", static_map)
-    step("actuator dynamics A(s)", "actuator_dynamic", dynamics)
-    step("radius, flywheel, brake gain, friction", "brake_", braking)
+    step("valve static map", ramps, "quasi-static ramp", static_map)
+    step("actuator dynamics A(s)", dynamic, "actuator steps/sweep", dynamics)
+    step("radius, flywheel, brake gain, friction", braking_runs, "braking", braking)
     return Identification(params, tuple(estimates), classes, tuple(problems), frf, points)

@@ -18,7 +18,8 @@ from .integrate import SimulationResult
 from .linear import FrequencyResponse
 
 
-def _save(fig: plt.Figure, path: Path) -> Path:
+def save_figure(fig: plt.Figure, path: Path) -> Path:
+    """Write ``fig`` as PNG (creating the folder) and close it."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
@@ -53,7 +54,7 @@ def plot_simulation(result: SimulationResult, path: Path) -> Path:
     fig.suptitle(f"{result.scenario.name}: {result.scenario.description} "
                  f"({result.stop_reason} at {t[-1]:.2f} s)")
     fig.tight_layout()
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_bode(responses: Sequence[FrequencyResponse], path: Path) -> Path:
@@ -81,4 +82,4 @@ def plot_bode(responses: Sequence[FrequencyResponse], path: Path) -> Path:
         axis.grid(alpha=0.3, which="both")
     axes[0, 0].legend(fontsize=7)
     fig.tight_layout()
-    return _save(fig, path)
+    return save_figure(fig, path)

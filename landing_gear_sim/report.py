@@ -17,7 +17,7 @@ import numpy as np
 
 from .identify import Estimate, FrfEstimate
 from .parameters import RigParameters
-from .plotting import _save
+from .plotting import save_figure
 from .validate import CHANNELS, RunComparison
 
 _UNITS = {"pressure_pa": (1e-5, "bar"), "wheel_speed_rad_s": (1.0, "rad/s"),
@@ -45,7 +45,7 @@ def plot_overlay(comparison: RunComparison, path: Path) -> Path:
     axes[-1, 0].set_xlabel("time [s]")
     fig.suptitle(f"{m.name} ({comparison.kind})")
     fig.tight_layout()
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_friction(slip: np.ndarray, mu: np.ndarray, params: RigParameters, path: Path) -> Path:
@@ -62,7 +62,7 @@ def plot_friction(slip: np.ndarray, mu: np.ndarray, params: RigParameters, path:
     axis.grid(alpha=0.3)
     axis.legend()
     fig.tight_layout()
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_frf(frf: FrfEstimate, path: Path) -> Path:
@@ -83,7 +83,7 @@ def plot_frf(frf: FrfEstimate, path: Path) -> Path:
     for axis in axes:
         axis.grid(alpha=0.3, which="both")
     fig.tight_layout()
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def scores_table(comparisons: Sequence[RunComparison]) -> list[list[str]]:

@@ -24,6 +24,11 @@ HAS_RADIUS = INDEX["elements.load_dependent_radius"]
 HAS_ACTUATOR_DYNAMICS = INDEX["elements.actuator_dynamics"]
 HAS_DRAG = INDEX["elements.drag"]
 HAS_ACTUATOR_DELAY = INDEX["elements.actuator_delay"]
+HAS_RELAXATION = INDEX["elements.tire_relaxation"]
+HAS_FADE = INDEX["elements.brake_fade"]
+RELAXATION = INDEX["tyre.relaxation_length_m"]
+FADE_FRACTION = INDEX["brake.fade_fraction"]
+FADE_ENERGY = INDEX["brake.fade_energy_j"]
 FLY_RADIUS = INDEX["flywheel.radius_m"]
 FLY_INERTIA = INDEX["flywheel.inertia_kg_m2"]
 DRAG = INDEX["drag.coeff_n_s2_per_m2"]
@@ -86,9 +91,24 @@ def slip_ratio(hub_speed_m_s, wheel_speed_rad_s, radius_m):
 
 
 @njit(cache=True)
-def brake_torque(p, pressure_pa):
-    """Brake torque T_b = k_b P_b, eq. (8); a brake cannot push, so P_b < 0 gives 0."""
-    return p[BRAKE_GAIN] * max(pressure_pa, 0.0)
+def brake_torque(p, pressure_pa, brake_energy_j):
+    """Brake torque T_b = k_b P_b, eq. (8); a brake cannot push, so P_b < 0 gives 0.
+
+    With ``brake_fade`` the gain falls as the brake heats:
+    k_b (1 − φ (1 − e^{−E/E_f})), E the energy the brake has absorbed.
+    """
+    gain = p[BRAKE_GAIN]
+    if p[HAS_FADE]:
+        gain *= 1.0 - p[FADE_FRACTION] * (1.0 - math.exp(-brake_energy_j / p[FADE_ENERGY]))
+    return gain * max(pressure_pa, 0.0)
+
+
+@njit(cache=True)
+def relaxation_rate(p, hub_speed_m_s):
+    """1/τ of the tyre force lag, v_h/σ (0 when the element is off)."""
+    if p[HAS_RELAXATION] == 0.0:
+        return 0.0
+    return max(hub_speed_m_s, MIN_HUB_SPEED_M_S) / p[RELAXATION]
 
 
 @njit(cache=True)

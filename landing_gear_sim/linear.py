@@ -14,9 +14,21 @@ import numpy as np
 
 from . import elements as el
 from .parameters import RigParameters
-from .plant import ANGLE, ANGLE_RATE, N_STATES, OMEGA, SPEED, derivatives, tyre_state
+from .plant import (
+    ANGLE,
+    ANGLE_RATE,
+    N_STATES,
+    OMEGA,
+    SPEED,
+    TYRE_FORCE,
+    derivatives,
+    tyre_state,
+)
 
-_LINEAR_STATES = (ANGLE, ANGLE_RATE, OMEGA)
+
+def linear_states(params: RigParameters) -> tuple[int, ...]:
+    """Plant states of the linear model: θ, θ̇, ω, and the relaxed tyre force if modelled."""
+    return (ANGLE, ANGLE_RATE, OMEGA, *((TYRE_FORCE,) if params.has("tire_relaxation") else ()))
 
 
 @dataclass(frozen=True)
@@ -34,7 +46,8 @@ class OperatingPoint:
 class LinearModel:
     """ẋ = A x + B u, y = C x + D u with u = brake torque [N m], y = (λ, η).
 
-    States (θ [rad], θ̇ [rad/s], ω [rad/s]); shapes A (3, 3), B (3,), C (2, 3), D (2,).
+    States (θ [rad], θ̇ [rad/s], ω [rad/s] and, with tyre relaxation, F_x [N]); shapes
+    A (n, n), B (n,), C (2, n), D (2,).
     """
 
     point: OperatingPoint
@@ -63,6 +76,7 @@ def operating_point(params: RigParameters, speed_m_s: float, slip: float = 0.05)
     x = np.zeros(N_STATES)
     x[SPEED], x[OMEGA] = speed_m_s, speed_m_s * (1.0 - slip) / radius
     force = load * el.burckhardt(p, slip)
+    x[TYRE_FORCE] = force
     if params.has("gear_walk"):
         x[ANGLE] = params.number("gear_walk.length_m") * force / params.number(
             "gear_walk.stiffness_n_m_per_rad")
@@ -74,20 +88,25 @@ def linearise(params: RigParameters, point: OperatingPoint) -> LinearModel:
     """Central-difference Jacobians of the plant at ``point``, speed frozen."""
     p = params.vector()
     gain = params.number("brake.gain_n_m_per_pa")
-    scales = np.array([1e-6, 1e-5, 1e-5 * max(point.state[OMEGA], 1.0)])
+    states = list(linear_states(params))
+    steps = {ANGLE: 1e-6, ANGLE_RATE: 1e-5, OMEGA: 1e-5 * max(point.state[OMEGA], 1.0),
+             TYRE_FORCE: 1e-3 * max(abs(point.state[TYRE_FORCE]), 1.0)}
 
     def rates(x: np.ndarray, torque: float) -> np.ndarray:
         dx = np.zeros(N_STATES)
         derivatives(p, x, torque / gain, point.vertical_load_n, dx)
-        return dx[list(_LINEAR_STATES)]
+        return dx[states]
 
     def outputs(x: np.ndarray, torque: float) -> np.ndarray:
         radius, _, slip, _ = tyre_state(p, x, point.vertical_load_n)
-        return np.array([slip, -rates(x, torque)[2] * radius / el.GRAVITY_M_S2])
+        return np.array([slip, -rates(x, torque)[states.index(OMEGA)] * radius
+                         / el.GRAVITY_M_S2])
 
     torque = point.pressure_pa * gain
-    a, c = np.zeros((3, 3)), np.zeros((2, 3))
-    for j, (state, h) in enumerate(zip(_LINEAR_STATES, scales, strict=True)):
+    n = len(states)
+    a, c = np.zeros((n, n)), np.zeros((2, n))
+    for j, state in enumerate(states):
+        h = steps[state]
         up, down = point.state.copy(), point.state.copy()
         up[state] += h
         down[state] -= h
@@ -104,7 +123,7 @@ def frequency_response(params: RigParameters, speed_m_s: float, frequency_hz: np
     """G_λ(jω), G_η(jω) at ``speed_m_s`` for the frequencies given [Hz]."""
     model = linearise(params, operating_point(params, speed_m_s, slip))
     frequencies = np.asarray(frequency_hz, dtype=float)
-    identity = np.eye(3)
+    identity = np.eye(model.a.shape[0])
     response = np.array([
         model.c @ np.linalg.solve(2j * np.pi * f * identity - model.a, model.b) + model.d
         for f in frequencies

@@ -23,7 +23,8 @@ import yaml
 from .errors import ParameterError
 
 ELEMENTS: tuple[str, ...] = ("gear_walk", "load_dependent_radius", "actuator_dynamics", "drag",
-                             "actuator_delay", "pressure_sensor_offset")
+                             "actuator_delay", "pressure_sensor_offset", "tire_relaxation",
+                             "brake_fade")
 """Model elements that can be switched on or off (``elements.<name>``). The last ones are
 extensions the reference rig does not have (off in its file)."""
 
@@ -72,6 +73,10 @@ SPECS: tuple[ParamSpec, ...] = (
     _f("aircraft.wheel_mass_kg", "kg", "wheel mass m_w", positive=False),
     _f("aircraft.gear_mass_kg", "kg", "gear mass m_gw", positive=False),
     _f("brake.gain_n_m_per_pa", "N m/Pa", "brake gain k_b = mu_b A_p R_eff n_s"),
+    _f("brake.fade_fraction", "-", "gain lost when fully faded (brake_fade)", positive=False),
+    _f("brake.fade_energy_j", "J", "brake energy scale of the fade (brake_fade)"),
+    _f("tyre.relaxation_length_m", "m", "tyre relaxation length (tire_relaxation)",
+       positive=False),
     _f("actuator.max_current_a", "A", "valve current range upper limit"),
     _f("actuator.deadband_current_a", "A", "static map dead-band I0", positive=False),
     _f("actuator.map_k1_pa_per_a", "Pa/A", "static map linear gain k1"),
@@ -301,6 +306,10 @@ def _check_known(values: Iterable[str], source: str) -> None:
             raise ParameterError(f"{source}: unknown parameter {key!r}{suggestion}")
 
 
+_NEEDS_POSITIVE = {"tire_relaxation": "tyre.relaxation_length_m"}
+"""An element that is on needs this parameter > 0."""
+
+
 def _check_values(values: Mapping[str, Any], origin: Mapping[str, str],
                   sources: Sequence[str]) -> None:
     for spec in SPECS:
@@ -312,6 +321,14 @@ def _check_values(values: Mapping[str, Any], origin: Mapping[str, str],
         if problem:
             where = origin.get(spec.key) or ", ".join(sources) or "parameters"
             raise ParameterError(f"{where}: parameter {spec.key!r} {problem}")
+    for element, key in _NEEDS_POSITIVE.items():
+        if values[f"elements.{element}"] and values[key] <= 0:
+            where = origin.get(key) or ", ".join(sources) or "parameters"
+            raise ParameterError(f"{where}: parameter {key!r} must be > 0 when "
+                                 f"elements.{element} is true")
+    if values["brake.fade_fraction"] >= 1:
+        raise ParameterError(f"{origin.get('brake.fade_fraction') or ', '.join(sources)}: "
+                             "parameter 'brake.fade_fraction' must be < 1")
 
 
 def _problem(spec: ParamSpec, value: Any) -> str | None:

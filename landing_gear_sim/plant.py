@@ -17,7 +17,8 @@ locked while the brake torque exceeds the tyre torque.
 
 Plant state vector (``N_STATES``): speed v (flywheel rim or aircraft) [m/s],
 gear-walk angle θ [rad] and rate [rad/s], wheel speed ω [rad/s], and four energy
-accumulators [J] (brake, drag, tyre slip, gear-walk damping) for bookkeeping.
+accumulators [J] (brake, drag, tyre slip, gear-walk damping) for bookkeeping, and the
+relaxed tyre force [N] (used by the ``tire_relaxation`` element only).
 """
 
 from __future__ import annotations
@@ -31,8 +32,8 @@ from numba import njit
 from . import elements as el
 from .parameters import INDEX
 
-SPEED, ANGLE, ANGLE_RATE, OMEGA, E_BRAKE, E_DRAG, E_SLIP, E_DAMP = range(8)
-N_STATES = 8
+SPEED, ANGLE, ANGLE_RATE, OMEGA, E_BRAKE, E_DRAG, E_SLIP, E_DAMP, TYRE_FORCE = range(9)
+N_STATES = 9
 
 MAX_SUBSTEP_S = 1e-3  # physics runs at 1 kHz or finer whatever the exchange rate
 STABILITY_MARGIN = 1.0  # h·|λ_max| per substep; RK4's real-axis limit is 2.78
@@ -55,18 +56,22 @@ _ACT_DELAY = INDEX["actuator.delay_s"]
 
 @njit(cache=True)
 def tyre_state(p, x, vertical_load_n):
-    """Radius [m], hub speed [m/s], slip [-] and tyre force F_x [N] at state ``x``."""
+    """Radius [m], hub speed [m/s], slip [-] and tyre force F_x [N] at state ``x``.
+
+    F_x is F_z μ(λ), or the relaxed force state when ``tire_relaxation`` is on.
+    """
     radius = el.rolling_radius(p, vertical_load_n)
     hub = x[SPEED] - p[el.GW_LENGTH] * x[ANGLE_RATE] if p[el.HAS_GEAR_WALK] else x[SPEED]
     slip = el.slip_ratio(hub, x[OMEGA], radius)
-    return radius, hub, slip, vertical_load_n * el.burckhardt(p, slip)
+    force = x[TYRE_FORCE] if p[el.HAS_RELAXATION] else vertical_load_n * el.burckhardt(p, slip)
+    return radius, hub, slip, force
 
 
 @njit(cache=True)
 def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     """Write dx/dt of the plant state into ``dx`` (eqs. 1-8; rig or aircraft form)."""
-    radius, hub, _, fx = tyre_state(p, x, vertical_load_n)
-    tb = el.brake_torque(p, pressure_pa)
+    radius, hub, slip, fx = tyre_state(p, x, vertical_load_n)
+    tb = el.brake_torque(p, pressure_pa, x[E_BRAKE])
     drag = el.drag_force(p, x[SPEED])
     mass = el.translational_mass(p)
     if p[el.HAS_GEAR_WALK] == 0.0:
@@ -89,6 +94,8 @@ def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     dx[E_DRAG] = drag * x[SPEED]
     dx[E_SLIP] = fx * (hub - x[OMEGA] * radius)
     dx[E_DAMP] = p[el.GW_DAMPING] * x[ANGLE_RATE] ** 2 if p[el.HAS_GEAR_WALK] else 0.0
+    steady = vertical_load_n * el.burckhardt(p, slip)
+    dx[TYRE_FORCE] = el.relaxation_rate(p, hub) * (steady - x[TYRE_FORCE])
 
 
 @njit(cache=True)
@@ -99,7 +106,8 @@ def substep_count(p, x, step_s, max_load_n):
     compliance = radius * radius / p[el.WHEEL_INERTIA] + 1.0 / el.translational_mass(p)
     if p[el.HAS_GEAR_WALK]:
         compliance += p[el.GW_LENGTH] ** 2 / p[el.GW_INERTIA]
-    rate = max_load_n * el.burckhardt_slope_max(p) * compliance / hub
+    rate = max(max_load_n * el.burckhardt_slope_max(p) * compliance / hub,
+               el.relaxation_rate(p, hub))
     n_stiff = math.ceil(step_s * rate / STABILITY_MARGIN)
     n_max = math.ceil(step_s / MAX_SUBSTEP_S - 1e-9)
     return max(n_stiff, n_max, 1)
@@ -215,7 +223,7 @@ def loading_step(p, xl, time_s, speed_m_s, step_s):
 def record(p, x, time_s, current_a, pressure_pa, load_n, row):
     """Fill one output row (see CHANNELS) from the state at ``time_s``."""
     radius, hub, slip, fx = tyre_state(p, x, load_n)
-    tb = el.brake_torque(p, pressure_pa)
+    tb = el.brake_torque(p, pressure_pa, x[E_BRAKE])
     omega_dot = el.wheel_acceleration(p, x[OMEGA], radius, fx, tb)
     row[0], row[1], row[2] = time_s, current_a, pressure_pa
     row[3], row[4], row[5] = x[OMEGA], x[SPEED], hub

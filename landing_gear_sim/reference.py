@@ -17,13 +17,8 @@ from scipy.integrate import solve_ivp
 
 from . import elements as el
 from .parameters import INDEX, RigParameters
-from .plant import ANGLE, ANGLE_RATE, N_STATES, OMEGA, SPEED, derivatives
+from .plant import ANGLE, ANGLE_RATE, E_BRAKE, N_STATES, OMEGA, SPEED, TYRE_FORCE, derivatives
 from .scenario import Scenario
-
-# Only dynamic states: the energy accumulators influence nothing, and their zero
-# Jacobian columns make Radau's finite-difference Jacobian diverge.
-_DYNAMIC = np.array([SPEED, ANGLE, ANGLE_RATE, OMEGA])
-_PRESSURE, _PRESSURE_RATE, _LOAD = 4, 5, 6
 
 
 def reference_solution(params: RigParameters, scenario: Scenario, end_s: float | None = None,
@@ -43,26 +38,34 @@ def reference_solution(params: RigParameters, scenario: Scenario, end_s: float |
     x, dx = np.zeros(N_STATES), np.zeros(N_STATES)
     p_max = p[INDEX["actuator.max_pressure_pa"]]
     v_max = max(scenario.initial_speed_m_s, 1.0)
-    scale = np.array([v_max, 0.1, 1.0, v_max / p[INDEX["wheel.unloaded_radius_m"]],
-                      p_max, wn * p_max, p[INDEX["loading.static_load_n"]]])
+    load = p[INDEX["loading.static_load_n"]]
+    # Only states that act: an accumulator nothing depends on has a zero Jacobian
+    # column, and Radau's finite-difference Jacobian then diverges.
+    dynamic = [SPEED, ANGLE, ANGLE_RATE, OMEGA]
+    scales = [v_max, 0.1, 1.0, v_max / p[INDEX["wheel.unloaded_radius_m"]]]
+    if params.has("tire_relaxation"):
+        dynamic, scales = [*dynamic, TYRE_FORCE], [*scales, load]
+    if params.has("brake_fade"):
+        dynamic, scales = [*dynamic, E_BRAKE], [*scales, 1e7]
+    pressure_i, rate_i, load_i = len(dynamic), len(dynamic) + 1, len(dynamic) + 2
+    scale = np.array([*scales, p_max, wn * p_max, load])
 
     def rhs(t: float, y: np.ndarray, current: float) -> np.ndarray:
         static = el.valve_static_pressure(p, current)
-        load = y[_LOAD] if scenario.contact else 0.0
-        x[_DYNAMIC] = y[:_PRESSURE]
-        derivatives(p, x, y[_PRESSURE], load, dx)
+        vertical = y[load_i] if scenario.contact else 0.0
+        x[dynamic] = y[:pressure_i]
+        derivatives(p, x, y[pressure_i], vertical, dx)
         out = np.empty_like(y)
-        out[:_PRESSURE] = dx[_DYNAMIC]
-        out[_PRESSURE] = y[_PRESSURE_RATE]
-        out[_PRESSURE_RATE] = wn * wn * (gain * static - y[_PRESSURE]) \
-            - 2 * zeta * wn * y[_PRESSURE_RATE]
+        out[:pressure_i] = dx[dynamic]
+        out[pressure_i] = y[rate_i]
+        out[rate_i] = wn * wn * (gain * static - y[pressure_i]) - 2 * zeta * wn * y[rate_i]
         reference = el.vertical_load_reference(p, t, y[0]) if scenario.contact else 0.0
-        out[_LOAD] = (reference - y[_LOAD]) / tau
+        out[load_i] = (reference - y[load_i]) / tau
         return out
 
     n = scenario.current_a.size if end_s is None else round(end_s * scenario.rate_hz) + 1
     times = np.arange(n) * scenario.step_s
-    y = np.zeros(_LOAD + 1)
+    y = np.zeros(load_i + 1)
     y[0] = scenario.initial_speed_m_s if scenario.contact else 0.0
     samples = np.empty((n, y.size))
     samples[0] = y
@@ -74,4 +77,4 @@ def reference_solution(params: RigParameters, scenario: Scenario, end_s: float |
         samples[a + 1: b + 1] = sol.y.T
         y = sol.y[:, -1]
     return {"time_s": times, "wheel_speed_rad_s": samples[:, 3],
-            "speed_m_s": samples[:, 0], "pressure_pa": samples[:, _PRESSURE]}
+            "speed_m_s": samples[:, 0], "pressure_pa": samples[:, pressure_i]}

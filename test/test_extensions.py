@@ -65,3 +65,78 @@ def test_only_an_offset_may_be_negative(reference):
         "sensors.pressure_offset_pa") == -1e4
     with pytest.raises(ParameterError, match=r"actuator\.delay_s.*must not be negative"):
         reference.replace({"actuator.delay_s": -0.001})
+
+
+RELAXED = {"elements.tire_relaxation": True, "tyre.relaxation_length_m": 0.5}
+FADING = {"elements.brake_fade": True, "brake.fade_fraction": 0.3,
+          "brake.fade_energy_j": 2e6}
+
+
+def _burckhardt(params, slip):
+    t1, t2, t3 = (params.number(f"friction.theta{i}") for i in (1, 2, 3))
+    return t1 * (1 - np.exp(-t2 * slip)) - t3 * slip
+
+
+def test_relaxed_tyre_force_follows_the_first_order_law(reference):
+    relaxed = reference.replace(RELAXED)
+    result = simulate(relaxed, sc.rig_test(relaxed, sc.oscillating(**sc.OSC_LOW)))
+    k = np.arange(2500, 6000)
+    rate = np.gradient(result.longitudinal_force_n, 1e-3)[k]
+    steady = result.vertical_load_n[k] * _burckhardt(relaxed, result.slip[k])
+    law = result.hub_speed_m_s[k] / 0.5 * (steady - result.longitudinal_force_n[k])
+    assert np.sqrt(np.mean((rate - law) ** 2)) < 0.02 * np.sqrt(np.mean(law ** 2))
+    assert np.max(np.abs(steady - result.longitudinal_force_n[k])) > 500.0  # it does lag
+
+
+def test_short_relaxation_length_tends_to_the_plain_tyre(reference):
+    scenario = sc.rig_test(reference, sc.oscillating(**sc.OSC_HIGH))
+    plain = simulate(reference, scenario)
+    short = simulate(reference.replace({**RELAXED, "tyre.relaxation_length_m": 0.002}),
+                     scenario)
+    n = min(len(plain), len(short))
+    assert np.max(np.abs(plain.wheel_speed_rad_s[:n] - short.wheel_speed_rad_s[:n])) < 0.5
+
+
+def test_relaxation_needs_a_length(reference):
+    with pytest.raises(ParameterError, match=r"relaxation_length_m' must be > 0 when"):
+        reference.replace({"elements.tire_relaxation": True})
+
+
+def test_faded_brake_torque_follows_the_absorbed_energy(reference):
+    fading = reference.replace(FADING)
+    result = simulate(fading, sc.constant_pressure_test(fading, 30e5))
+    expected = 1.5e-3 * np.maximum(result.pressure_pa, 0) * (
+        1 - 0.3 * (1 - np.exp(-result.brake_energy_j / 2e6)))
+    assert np.allclose(result.brake_torque_n_m, expected, rtol=1e-12, atol=1e-9)
+    plain = simulate(reference, sc.constant_pressure_test(reference, 30e5))
+    assert result.time_s[-1] > 1.1 * plain.time_s[-1]  # a fading brake stops later
+
+
+def test_fade_fraction_below_one(reference):
+    with pytest.raises(ParameterError, match="fade_fraction' must be < 1"):
+        reference.replace({"brake.fade_fraction": 1.0})
+
+
+@pytest.mark.parametrize("extension", [RELAXED, FADING])
+def test_extensions_match_the_tight_radau_reference(reference, extension):
+    from landing_gear_sim.reference import reference_solution
+
+    extended = reference.replace(extension)
+    scenario = sc.rig_test(extended, sc.oscillating(**sc.OSC_LOW))
+    fast = simulate(extended, scenario)
+    exact = reference_solution(extended, scenario, end_s=3.0)
+    n = exact["time_s"].size
+    error = fast.wheel_speed_rad_s[:n] - exact["wheel_speed_rad_s"]
+    assert np.sqrt(np.mean(error ** 2)) < 1e-3 * 60.0 / 0.31
+
+
+def test_energy_balance_holds_with_relaxation_and_fade(reference):
+    extended = reference.replace({**RELAXED, **FADING})
+    result = simulate(extended, sc.constant_pressure_test(extended, 30e5))
+    mass = 3500.0
+    lost = 0.5 * mass * (result.speed_m_s[0] ** 2 - result.speed_m_s[-1] ** 2)
+    spent = (result.brake_energy_j[-1] + result.drag_energy_j[-1] + result.slip_energy_j[-1]
+             + result.damping_energy_j[-1] + 0.75 * result.wheel_speed_rad_s[-1] ** 2
+             + 0.5 * 272.9 * result.gear_rate_rad_s[-1] ** 2
+             + 0.5 * 6.9e5 * result.gear_angle_rad[-1] ** 2)
+    assert abs(lost - spent) < 1e-4 * lost

@@ -8,7 +8,7 @@ tests and benchmarks; identification and diagnosis never read that file.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -54,12 +54,16 @@ def standard_scenarios(p: RigParameters) -> dict[str, sc.Scenario]:
     return {name: build() for name, build in runs.items()}
 
 
-def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0) -> list[Path]:
-    """Simulate and write the standard runs of ``rig`` into ``folder``; returns the CSV paths."""
+def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,
+                      names: Sequence[str] | None = None) -> list[Path]:
+    """Simulate and write the standard runs of ``rig`` (or those in ``names``) into
+    ``folder``; returns the CSV paths."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     written = []
     for i, (name, scenario) in enumerate(standard_scenarios(rig).items()):
+        if names is not None and name not in names:
+            continue
         run = simulate(rig, scenario).to_run(noise_seed=seed * 100 + i)
         path = folder / f"{name}.csv"
         write_csv(run, path)

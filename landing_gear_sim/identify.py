@@ -31,11 +31,13 @@ from scipy.optimize import least_squares
 from msg_tools.run import Run
 
 from . import elements as el
+from .errors import ParameterError
 from .parameters import RigParameters
 from .plant import actuator_matrices, actuator_state, actuator_step
 from .scenario import logged_to_held
 
 FILTER_HZ = 20.0  # zero-phase low-pass before differentiating speeds
+REFINE_BOUNDS = (0.2, 5.0)  # output-error refinement stays within these factors of the start
 Progress = Callable[[str], None]
 
 
@@ -415,7 +417,8 @@ def refine_friction(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
         trial = p.replace(dict(zip(keys, theta * start, strict=True)), "identify")
         return np.concatenate([slip_error(runs[i], windows[i], trial) for i in chosen])
 
-    fit = least_squares(lambda th: residual(th, range(len(runs))), np.ones(3), diff_step=1e-4)
+    fit = least_squares(lambda th: residual(th, range(len(runs))), np.ones(3), diff_step=1e-4,
+                        bounds=REFINE_BOUNDS)
     std = np.maximum(_covariance_std(fit, 3), _jackknife_std(residual, fit.x, len(runs)))
     names = tuple(r.name for r in runs)
     return [Estimate(k, float(v), float(sd), names,
@@ -429,7 +432,8 @@ def _jackknife_std(residual: Callable[[np.ndarray, Sequence[int]], np.ndarray],
     if n_runs < 3:
         return np.zeros_like(solution)
     fits = [least_squares(lambda th, i=i: residual(th, [j for j in range(n_runs) if j != i]),
-                          solution, diff_step=1e-4).x for i in range(n_runs)]
+                          solution, diff_step=1e-4, bounds=REFINE_BOUNDS).x
+            for i in range(n_runs)]
     spread = np.asarray(fits) - np.mean(fits, axis=0)
     return np.sqrt((n_runs - 1) / n_runs * np.sum(spread ** 2, axis=0))
 
@@ -462,7 +466,7 @@ def identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool = False,
         say(f"identifying {name}")
         try:
             action()
-        except (ValueError, np.linalg.LinAlgError) as exc:
+        except (ValueError, np.linalg.LinAlgError, ParameterError) as exc:
             problems.append(f"{name}: failed ({exc})")
 
     ramps = by_class.get("actuator_ramp", [])

@@ -19,7 +19,7 @@ from scipy.optimize import least_squares
 
 from msg_tools.run import Run
 
-from .identify import _correlation_inflation, classify
+from .identify import classify, covariance_std
 from .parameters import RigParameters
 from .validate import simulate_run
 
@@ -168,10 +168,7 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
                 best = fit
     assert best is not None
     values = lower + best.x * span
-    jac, res = best.jac, best.fun
-    sigma2 = float(res @ res) / max(res.size - len(keys), 1) * _correlation_inflation(res)
-    cov = np.linalg.pinv(jac.T @ jac) * sigma2
-    std = np.sqrt(np.clip(np.diag(cov), 0.0, None)) * span
+    std = covariance_std(best, len(keys)) * span
     fitted = switched.replace(dict(zip(keys, values, strict=True)), f"fit {candidate.cause}")
     return CandidateFit(candidate, fitted, dict(zip(keys, map(float, values), strict=True)),
                         dict(zip(keys, map(float, std), strict=True)), best.fun)

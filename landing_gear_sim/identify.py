@@ -110,7 +110,7 @@ def _correlation_inflation(residual: np.ndarray) -> float:
     return (1 + rho) / (1 - rho) if 0 < rho < 1 else 1.0
 
 
-def _covariance_std(result: object, n_params: int) -> np.ndarray:
+def covariance_std(result: object, n_params: int) -> np.ndarray:
     """1-σ from a least_squares result: σ² (JᵀJ)⁻¹, σ² from the (correlated) residuals."""
     jac, residual = result.jac, result.fun  # type: ignore[attr-defined]
     return _linear_std(jac, residual, n_params)
@@ -141,7 +141,7 @@ def fit_static_map(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
 
     start = np.array([p.number(k) for k in keys]) / scale
     fit = least_squares(lambda th: (model(th) - pressure) / 1e5, start, x_scale="jac")
-    std = _covariance_std(fit, 4) * scale
+    std = covariance_std(fit, 4) * scale
     names = tuple(r.name for r in runs)
     return [Estimate(k, float(v), float(s), names, "static-map least squares")
             for k, v, s in zip(keys, fit.x * scale, std, strict=True)]
@@ -219,7 +219,7 @@ def fit_actuator_dynamics(runs: Sequence[Run], p: RigParameters
 
     fit = least_squares(time_residual, [wn_frf, zeta_frf], x_scale=[wn_frf, 0.1],
                         bounds=([1.0, 0.05], [2000.0, 3.0]))
-    std = _covariance_std(fit, 2)
+    std = covariance_std(fit, 2)
     names = (run.name,)
     estimates = [
         Estimate("actuator.natural_frequency_hz", fit.x[0] / (2 * math.pi),
@@ -381,7 +381,7 @@ def fit_friction(slip: np.ndarray, mu: np.ndarray, p: RigParameters, names: tupl
 
     fit = least_squares(residual, start[:free], x_scale=start[:free],
                         bounds=(np.zeros(free), np.full(free, np.inf)))
-    std = _covariance_std(fit, free)
+    std = covariance_std(fit, free)
     method = "Burckhardt least squares on slip/μ samples" + (" (theta3 fixed)" if fix_theta3
                                                              else "")
     estimates = [Estimate(k, float(v), float(s), names, method)
@@ -419,7 +419,7 @@ def refine_friction(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
 
     fit = least_squares(lambda th: residual(th, range(len(runs))), np.ones(3), diff_step=1e-4,
                         bounds=REFINE_BOUNDS)
-    std = np.maximum(_covariance_std(fit, 3), _jackknife_std(residual, fit.x, len(runs)))
+    std = np.maximum(covariance_std(fit, 3), _jackknife_std(residual, fit.x, len(runs)))
     names = tuple(r.name for r in runs)
     return [Estimate(k, float(v), float(sd), names,
                      "output error on wheel vs flywheel speed; σ: max(residual, jackknife)")

@@ -1,5 +1,5 @@
 # Two set-up commands on a fresh machine (each makes its own virtual environment):
-#   make demo   - simulate the reference rig and draw the plots (bundled defaults)
+#   make demo   - simulate the reference rig, calibrate and diagnose synthetic campaigns
 #   make test   - lint and run the test suite
 PYTHON ?= python3
 VENV ?= .venv
@@ -9,7 +9,7 @@ STAMP := $(VENV)/.installed
 export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 export ROS_DOMAIN_ID ?= 42
 
-.PHONY: demo test bench lint clean
+.PHONY: demo test test-slow bench lint clean
 
 $(STAMP): setup.py setup.cfg
 	$(PYTHON) -m venv $(VENV)
@@ -27,12 +27,18 @@ demo: $(STAMP)
 	$(BIN)/landing-gear-sim campaign out/campaign --seed 1
 	$(BIN)/landing-gear-sim identify out/campaign -o out/calibrated.yaml
 	$(BIN)/landing-gear-sim validate out/campaign --config out/calibrated.yaml --report out/validation
+	rm -rf out/campaign_delay
+	$(BIN)/landing-gear-sim campaign out/campaign_delay --seed 7 --set elements.actuator_delay=true --set actuator.delay_s=0.006
+	$(BIN)/landing-gear-sim diagnose out/campaign_delay --json out/diagnosis.json --report out/diagnosis -o out/extended.yaml
 
 lint: $(STAMP)
 	$(BIN)/ruff check landing_gear_sim antiskid msg_tools test bench
 
 test: lint
-	$(BIN)/python -m pytest -q test
+	$(BIN)/python -m pytest -q -n 2 test
+
+test-slow: lint
+	$(BIN)/python -m pytest -q -n 2 --slow test
 
 bench: $(STAMP)
 	$(BIN)/python bench/run.py

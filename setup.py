@@ -41,6 +41,7 @@ setup(
         ],
         "test": [
             "pytest>=7",
+            "pytest-xdist>=3",
             "ruff>=0.5",
             "colcon-common-extensions",
             "colcon-ros",

@@ -22,6 +22,9 @@ from .errors import LandingGearSimError
 from .parameters import ELEMENTS, SPECS, RigParameters, load_parameters, parse_assignment
 
 if TYPE_CHECKING:
+    from msg_tools.run import Run
+
+    from .diagnose import Diagnosis
     from .integrate import SimulationResult
 
 PROG = "landing-gear-sim"
@@ -49,19 +52,22 @@ def _constant_level(args: argparse.Namespace, params: RigParameters) -> float:
     return sc.current_for_pressure(params, args.pressure_bar * 1e5)
 
 
-def _add_params_arguments(parser: argparse.ArgumentParser) -> None:
+def _add_params_arguments(parser: argparse.ArgumentParser, without: bool = True) -> None:
     parser.add_argument("--config", action="append", type=Path, metavar="FILE",
                         help="ROS 2 params file; repeat to layer (default: bundled reference rig)")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                         help="override one parameter, e.g. --set friction.theta1=0.8")
-    parser.add_argument("--without", action="append", default=[], choices=ELEMENTS,
-                        metavar="ELEMENT", help=f"switch an element off ({', '.join(ELEMENTS)})")
+    if without:
+        parser.add_argument("--without", action="append", default=[], choices=ELEMENTS,
+                            metavar="ELEMENT",
+                            help=f"switch an element off ({', '.join(ELEMENTS)})")
 
 
 def _params(args: argparse.Namespace) -> RigParameters:
     overrides = dict(parse_assignment(text) for text in args.set)
     params = load_parameters(args.config, overrides or None)
-    return params.without(*args.without) if args.without else params
+    removed = getattr(args, "without", None) if args.command != "diagnose" else None
+    return params.without(*removed) if removed else params
 
 
 def _build_scenario(args: argparse.Namespace, params: RigParameters) -> sc.Scenario:
@@ -297,6 +303,75 @@ def cmd_convert(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_diagnose(args: argparse.Namespace) -> int:
+    import json
+
+    from msg_tools.io import read_runs
+
+    from .diagnose import diagnose
+
+    campaign = read_runs(args.runs, _mapping(args))
+    for problem in campaign.problems:
+        _progress(f"skipped: {problem}")
+    started = time.perf_counter()
+    result = diagnose(campaign.runs, _params(args), args.without,
+                      lambda m: _progress(f"[{time.perf_counter() - started:5.1f} s] {m}"))
+    result.problems[:0] = campaign.problems
+    print(_diagnosis_summary(result))
+    document = result.to_json()
+    if args.json:
+        _write_atomically(args.json, lambda p: p.write_text(json.dumps(document, indent=1)))
+        print(f"json:   {args.json}")
+    if args.report:
+        _progress("writing the report")
+        page = _diagnosis_report(result, campaign.runs, args.report)
+        print(f"report: {page}")
+    if args.output:
+        _write_atomically(args.output, result.extended.to_yaml)
+        print(f"extended model: {args.output}")
+    print(f"diagnosed {len(campaign.runs)} runs in {time.perf_counter() - started:.1f} s")
+    return 0
+
+
+def _diagnosis_summary(result: Diagnosis) -> str:
+    from .report import text_table
+
+    def fits(values: dict[str, float]) -> str:
+        return ", ".join(f"{c.split('_')[0]} {v:.1f}" for c, v in values.items())
+
+    rows = [[f.cause, "yes" if f.accepted else "no", _maybe(f.delta_bic),
+             _maybe(f.held_out), f"{fits(f.fit_before)} -> {fits(f.fit_after)}"]
+            for f in result.candidates]
+    lines = ["candidates:", text_table(["cause", "accepted", "dBIC", "held-out", "held-out fit %"],
+                                       rows) if rows else "  (none: the model has them all)"]
+    lines.append(f"baseline fit %: {fits(result.baseline)}")
+    lines.append(f"VERDICT: {result.verdict}")
+    for f in result.findings:
+        values = ", ".join(f"{k} = {v:.6g}" + (f" ± {f.std[k]:.2g}" if k in f.std else "")
+                           for k, v in f.parameters.items())
+        lines.append(f"  {f.cause}: {values}")
+        if f.fit_after and f.fit_after != f.fit_before:
+            gain = ", ".join(f"{c} {f.fit_before[c]:.2f} -> {f.fit_after[c]:.2f} %"
+                             for c in f.fit_after)
+            lines.append(f"    held-out gain: {gain}")
+        lines.append(f"    evidence: {f.evidence}")
+    for problem in result.problems:
+        lines.append(f"  note: {problem}")
+    return "\n".join(lines)
+
+
+def _maybe(value: float | None) -> str:
+    return "-" if value is None else f"{value:+.0f}"
+
+
+def _diagnosis_report(result: Diagnosis, runs: Sequence[Run], folder: Path) -> Path:
+    from .diagnose import report_sections
+    from .report import write_html
+
+    sections = report_sections(result, runs, folder)
+    return write_html(folder / "index.html", f"Diagnosis: {result.verdict}", sections)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog=PROG, description="Landing-gear anti-skid rig "
                                      "digital twin: simulate, analyse, compare.")
@@ -370,6 +445,19 @@ def build_parser() -> argparse.ArgumentParser:
     conv.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
     conv.add_argument("--mapping", type=Path, help="column-mapping file for a CSV input")
     conv.set_defaults(func=cmd_convert)
+
+    diag = sub.add_parser("diagnose", help="why model and rig disagree: cause, extension, gain")
+    diag.add_argument("runs", type=Path, nargs="+", metavar="RUN",
+                      help="CSV files, bags, or campaign folders")
+    _add_params_arguments(diag, without=False)
+    diag.add_argument("--without", action="extend", nargs="+", default=[], metavar="ELEMENT",
+                      help="start from a model without these elements, e.g. gear_walk, "
+                      "friction_curve (the diagnosis must then rediscover them)")
+    diag.add_argument("--json", type=Path, help="write the diagnosis contract JSON here")
+    diag.add_argument("--report", type=Path, help="write the HTML report into this folder")
+    diag.add_argument("-o", "--output", type=Path, help="write the extended model (params)")
+    diag.add_argument("--mapping", type=Path, help="column-mapping file for the CSVs")
+    diag.set_defaults(func=cmd_diagnose)
 
     show = sub.add_parser("params", help="show (or write) the effective parameter set")
     _add_params_arguments(show)

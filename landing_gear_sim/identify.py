@@ -125,10 +125,17 @@ def _linear_std(design: np.ndarray, residual: np.ndarray, n_params: int) -> np.n
 
 # --- actuator ---------------------------------------------------------------------------
 
+def true_pressure(pressure_pa: np.ndarray, p: RigParameters) -> np.ndarray:
+    """The brake pressure behind a reading: less the sensor offset when the model has one."""
+    if not p.has("pressure_sensor_offset"):
+        return pressure_pa
+    return pressure_pa - p.number("sensors.pressure_offset_pa")
+
+
 def fit_static_map(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
     """Dead-band, k1, k2, saturation from quasi-static ramps (paper Fig. 8)."""
     current = np.concatenate([r.current_a for r in runs])
-    pressure = np.concatenate([r.pressure_pa for r in runs])
+    pressure = true_pressure(np.concatenate([r.pressure_pa for r in runs]), p)
     keys = ("actuator.deadband_current_a", "actuator.map_k1_pa_per_a",
             "actuator.map_k2_pa_per_a2", "actuator.max_pressure_pa")
     scale = np.array([p.number(k) or 1.0 for k in keys])
@@ -256,7 +263,8 @@ def _braking(run: Run, p: RigParameters) -> _Braking:
         run=run, time_s=run.time_s - run.time_s[0],
         speed_m_s=_lowpass(run.flywheel_speed_rad_s, rate) * p.number("flywheel.radius_m"),
         wheel=wheel, wheel_rate=np.gradient(wheel, 1.0 / rate),
-        pressure=_lowpass(run.pressure_pa, rate), load=_lowpass(run.vertical_load_n, rate),
+        pressure=_lowpass(true_pressure(run.pressure_pa, p), rate),
+        load=_lowpass(run.vertical_load_n, rate),
         force=_lowpass(run.longitudinal_force_n, rate),
         start_s=brake_start_s(run) - float(run.time_s[0]),
     )
@@ -337,19 +345,51 @@ def fit_flywheel(runs: Sequence[_Braking], p: RigParameters) -> list[Estimate]:
     ]
 
 
-def fit_brake_gain(runs: Sequence[_Braking], p: RigParameters) -> Estimate:
-    """k_b from the wheel torque balance r F_x − J_w ω̇ = k_b P (least squares)."""
-    torque, pressure = [], []
+def _torque_balance(b: _Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
+    """Brake torque r F_x − J_w ω̇ [N m] and the energy the brake absorbed, ∫ T_b ω dt [J]."""
+    torque = _radius(p, b.load) * b.force - p.number("wheel.inertia_kg_m2") * b.wheel_rate
+    dt = np.diff(b.time_s, prepend=b.time_s[0])
+    power = np.where(b.time_s > b.start_s - 0.1, np.clip(torque, 0, None), 0.0) \
+        * np.clip(b.wheel, 0, None)
+    return torque, np.cumsum(power * dt)
+
+
+def fit_brake_gain(runs: Sequence[_Braking], p: RigParameters) -> list[Estimate]:
+    """k_b from the wheel torque balance r F_x − J_w ω̇ = k_b P (least squares).
+
+    When the model has brake fade, k_b, φ and E_f of k_b (1 − φ(1 − e^{−E/E_f})) P are
+    fitted together, E the energy absorbed so far (measured by the same balance).
+    """
+    torque, pressure, energy = [], [], []
     for b in runs:
+        whole, absorbed = _torque_balance(b, p)
         m = (b.time_s > b.start_s + 0.2) & (b.pressure > 3e5) & (b.wheel > 5.0) & (b.load > 5e3)
-        radius = _radius(p, b.load[m])
-        torque.append(radius * b.force[m] - p.number("wheel.inertia_kg_m2") * b.wheel_rate[m])
+        torque.append(whole[m])
         pressure.append(b.pressure[m])
-    t, pr = np.concatenate(torque), np.concatenate(pressure)
-    gain = float(pr @ t / (pr @ pr))
-    std = float(_linear_std(pr[:, None], t - gain * pr, 1)[0])
-    return Estimate("brake.gain_n_m_per_pa", gain, std, tuple(b.run.name for b in runs),
-                    "wheel torque balance")
+        energy.append(absorbed[m])
+    t, pr, e = np.concatenate(torque), np.concatenate(pressure), np.concatenate(energy)
+    names = tuple(b.run.name for b in runs)
+    if not p.has("brake_fade"):
+        gain = float(pr @ t / (pr @ pr))
+        std = float(_linear_std(pr[:, None], t - gain * pr, 1)[0])
+        return [Estimate("brake.gain_n_m_per_pa", gain, std, names, "wheel torque balance")]
+    keys = ("brake.gain_n_m_per_pa", "brake.fade_fraction", "brake.fade_energy_j")
+
+    def residual(theta: np.ndarray) -> np.ndarray:
+        gain, fraction, log_energy = theta
+        fade = 1.0 - fraction * (1.0 - np.exp(-e / math.exp(log_energy)))
+        return (gain * 1e-3 * fade * pr - t) / 100.0
+
+    start = [p.number(keys[0]) * 1e3, p.number(keys[1]), math.log(p.number(keys[2]))]
+    fit = least_squares(residual, start, bounds=([1e-3, 0.0, math.log(1e3)],
+                                                 [1e2, 0.95, math.log(1e9)]))
+    std = covariance_std(fit, 3)
+    gain, fraction, log_energy = fit.x
+    method = "wheel torque balance with fade"
+    return [Estimate(keys[0], gain * 1e-3, std[0] * 1e-3, names, method),
+            Estimate(keys[1], fraction, std[1], names, method),
+            Estimate(keys[2], math.exp(log_energy), math.exp(log_energy) * std[2], names,
+                     method)]
 
 
 def friction_samples(runs: Sequence[_Braking], p: RigParameters
@@ -391,7 +431,8 @@ def fit_friction(slip: np.ndarray, mu: np.ndarray, p: RigParameters, names: tupl
     return estimates
 
 
-def refine_friction(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
+def refine_friction(runs: Sequence[Run], p: RigParameters, jackknife: bool = True
+                    ) -> list[Estimate]:
     """Output-error refinement of ϑ1..ϑ3: simulate the braking runs with their measured
     current and fit the wheel speed over the braking phase.
 
@@ -419,7 +460,9 @@ def refine_friction(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
 
     fit = least_squares(lambda th: residual(th, range(len(runs))), np.ones(3), diff_step=1e-4,
                         bounds=REFINE_BOUNDS)
-    std = np.maximum(covariance_std(fit, 3), _jackknife_std(residual, fit.x, len(runs)))
+    std = covariance_std(fit, 3)
+    if jackknife:
+        std = np.maximum(std, _jackknife_std(residual, fit.x, len(runs)))
     names = tuple(r.name for r in runs)
     return [Estimate(k, float(v), float(sd), names,
                      "output error on wheel vs flywheel speed; σ: max(residual, jackknife)")
@@ -441,8 +484,15 @@ def _jackknife_std(residual: Callable[[np.ndarray, Sequence[int]], np.ndarray],
 # --- driver -----------------------------------------------------------------------------
 
 def identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool = False,
-             progress: Progress | None = None) -> Identification:
-    """Calibrate ``base`` on ``runs``; a step without usable runs is skipped and reported."""
+             progress: Progress | None = None, *, friction: bool = True,
+             jackknife: bool = True) -> Identification:
+    """Calibrate ``base`` on ``runs``; a step without usable runs is skipped and reported.
+
+    ``friction=False`` keeps the friction curve of ``base`` (a model without a calibrated
+    curve, for the diagnosis); ``jackknife=False`` skips the leave-one-run-out spread of
+    the friction estimate (its σ is then the residual-based one, and identify is ~4x
+    faster).
+    """
     say = progress or (lambda _msg: None)
     classes = {r.name: classify(r) for r in runs}
     by_class: dict[str, list[Run]] = {}
@@ -486,12 +536,14 @@ def identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool = False,
         prepared = [_braking(r, params) for r in braking_runs]  # independent of what follows
         adopt([fit_unloaded_radius(prepared, params)])
         adopt(fit_flywheel(prepared, params))
-        adopt([fit_brake_gain(prepared, params)])
+        adopt(fit_brake_gain(prepared, params))
         points = friction_samples(prepared, params)
+        if not friction:
+            return
         adopt(fit_friction(*points, params, tuple(r.name for r in braking_runs), fix_theta3))
         if not fix_theta3:
             say("refining the friction curve on the braking runs (output error)")
-            refined = refine_friction(braking_runs, params)
+            refined = refine_friction(braking_runs, params, jackknife)
             estimates[:] = [e for e in estimates if not e.key.startswith("friction.")]
             adopt(refined)
 

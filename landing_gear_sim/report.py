@@ -15,9 +15,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from msg_tools.run import Run
+
 from .identify import Estimate, FrfEstimate
 from .parameters import RigParameters
 from .plotting import save_figure
+from .residuals import Spectrum
 from .validate import CHANNELS, RunComparison
 
 _UNITS = {"pressure_pa": (1e-5, "bar"), "wheel_speed_rad_s": (1.0, "rad/s"),
@@ -135,3 +138,55 @@ def html_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
 
 def html_image(path: Path, relative_to: Path) -> str:
     return f"<img src='{html.escape(str(Path(path).relative_to(relative_to)))}'>"
+
+
+def plot_before_after(measured: Run, before: Run, after: Run, channels: Sequence[str],
+                      path: Path) -> Path:
+    """Measured (black), starting model (blue) and extended model (red), and the two
+    residuals, per channel."""
+    fig, axes = plt.subplots(2 * len(channels), 1, figsize=(9, 3.2 * len(channels) + 0.6),
+                             sharex=True, squeeze=False)
+    t = measured.time_s - measured.time_s[0]
+    for i, channel in enumerate(channels):
+        factor, unit = _UNITS[channel]
+        y = getattr(measured, channel)
+        label = CHANNELS[channel].split(" [")[0]
+        top, bottom = axes[2 * i, 0], axes[2 * i + 1, 0]
+        top.plot(t, y * factor, "k", lw=0.6, label="measured")
+        top.plot(t, getattr(before, channel) * factor, "b", lw=0.8, label="starting model")
+        top.plot(t, getattr(after, channel) * factor, "r", lw=0.8, label="extended model")
+        top.set_ylabel(f"{label}\n[{unit}]")
+        bottom.plot(t, (y - getattr(before, channel)) * factor, "b", lw=0.5)
+        bottom.plot(t, (y - getattr(after, channel)) * factor, "r", lw=0.5)
+        bottom.set_ylabel(f"residual\n[{unit}]")
+        for axis in (top, bottom):
+            axis.grid(alpha=0.3)
+    axes[0, 0].legend(loc="upper right", fontsize=8)
+    axes[-1, 0].set_xlabel("time [s]")
+    fig.suptitle(measured.name)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def plot_spectrum(spectrum: Spectrum, title: str, unit: str, path: Path) -> Path:
+    """Residual PSD, its noise floor, the detection threshold and the detected lines."""
+    f = spectrum.frequency_hz
+    band = f > 0
+    fig, axis = plt.subplots(figsize=(8, 3.8))
+    axis.loglog(f[band], spectrum.psd[band], "k", lw=0.7, label="residual PSD")
+    finite = band & np.isfinite(spectrum.floor)
+    axis.loglog(f[finite], spectrum.floor[finite], "g", lw=0.8, label="noise floor")
+    axis.loglog(f[finite], spectrum.floor[finite] * spectrum.threshold, "g--", lw=0.6,
+                label="detection threshold (1 % family-wise)")
+    for peak in spectrum.peaks[:5]:
+        i = int(np.argmin(np.abs(f - peak.frequency_hz)))
+        axis.plot(f[i], spectrum.psd[i], "rv", ms=8)
+        axis.annotate(f"{peak.frequency_hz:.2f} Hz", (f[i], spectrum.psd[i]), fontsize=8,
+                      xytext=(4, 6), textcoords="offset points", color="r")
+    axis.set_xlabel("frequency [Hz]")
+    axis.set_ylabel(f"PSD [{unit}²/Hz]")
+    axis.set_title(title, fontsize=10)
+    axis.grid(alpha=0.3, which="both")
+    axis.legend(fontsize=8)
+    fig.tight_layout()
+    return save_figure(fig, path)

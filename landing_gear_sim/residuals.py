@@ -108,7 +108,7 @@ def autocorrelation(residual: np.ndarray, max_lag: int) -> Correlation:
     """Normalised autocorrelation, band ±z/√N for white residuals."""
     x = np.asarray(residual, dtype=float) - np.mean(residual)
     n = x.size
-    full = np.correlate(x, x, mode="full")[n - 1: n + max_lag] / (x @ x)
+    full = scipy.signal.correlate(x, x, mode="full", method="fft")[n - 1: n + max_lag] / (x @ x)
     return Correlation(np.arange(max_lag + 1), full, _band(n))
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -60,6 +61,28 @@ def read_campaign(folder: Path, mapping: Mapping | None = None) -> Campaign:
         raise RunFormatError(f"{folder}: no readable run" +
                              (f" ({'; '.join(problems)})" if problems else ""))
     return Campaign(Path(folder), tuple(runs), tuple(problems))
+
+
+def read_runs(paths: Sequence[Path], mapping: Mapping | None = None) -> Campaign:
+    """Runs from files, bags and campaign folders, in the order given.
+
+    A bad file inside a folder is reported and skipped; a bad file named explicitly
+    is an error (the user asked for it). Two runs with the same name are an error.
+    """
+    runs: list[Run] = []
+    problems: list[str] = []
+    for path in map(Path, paths):
+        if path.is_dir() and not is_bag(path):
+            campaign = read_campaign(path, mapping)
+            runs.extend(campaign.runs)
+            problems.extend(campaign.problems)
+        else:
+            runs.append(read_run(path, mapping))
+    names = [r.name for r in runs]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise RunFormatError(f"run name {twice[0]!r} given twice; runs need distinct names")
+    return Campaign(Path(paths[0]) if paths else Path("."), tuple(runs), tuple(problems))
 
 
 def resample(run: Run, rate_hz: float) -> Run:

@@ -1,0 +1,185 @@
+"""Diagnosis on campaigns that hide an effect (parameters drawn at random, unseen by the
+code under test): the verdict *and* the recovered key parameter."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+
+import numpy as np
+import pytest
+
+from landing_gear_sim.campaign import generate_campaign, rig_like
+from landing_gear_sim.catalogue import gear_walk_key_parameters
+from landing_gear_sim.cli import main
+from landing_gear_sim.diagnose import DiagnosisError, diagnose
+from msg_tools.csv_io import read_csv, write_csv
+from msg_tools.io import read_campaign
+
+# a short campaign (the two long constant-pressure stops left out) keeps the suite quick
+RUNS = ("actuator_ramp", "actuator_steps_sweep", "brake_const_30bar", "brake_const_40bar",
+        "brake_osc_low", "brake_osc_high")
+
+
+def _campaign(reference, folder, seed, effect=None):
+    rng = np.random.default_rng(seed)
+    rig = rig_like(reference, rng)
+    if effect is not None:
+        rig = rig.replace(effect(rng), "hidden effect")
+    generate_campaign(folder, rig, seed, RUNS)
+    return read_campaign(folder).runs, rig
+
+
+def _finding(result, cause):
+    found = [f for f in result.findings if f.cause == cause]
+    assert found, f"no {cause} finding: verdict {result.verdict}"
+    return found[0]
+
+
+def test_a_campaign_without_extra_effect_gives_none(reference, tmp_path):
+    runs, _ = _campaign(reference, tmp_path, 101)
+    result = diagnose(runs, reference)
+    assert result.verdict == "none", [f.evidence for f in result.findings]
+    assert result.findings == []
+
+
+def test_actuator_delay_is_named_and_measured_within_a_millisecond(reference, tmp_path):
+    runs, rig = _campaign(reference, tmp_path, 102, lambda rng: {
+        "elements.actuator_delay": True, "actuator.delay_s": rng.uniform(0.003, 0.015)})
+    result = diagnose(runs, reference)
+    assert result.verdict == "actuator_delay"
+    delay = _finding(result, "actuator_delay").parameters["delay_s"]
+    assert delay == pytest.approx(rig.number("actuator.delay_s"), abs=1e-3)
+
+
+def test_pressure_sensor_offset_is_named_and_measured_within_20_percent(reference, tmp_path):
+    runs, rig = _campaign(reference, tmp_path, 103, lambda rng: {
+        "elements.pressure_sensor_offset": True,
+        "sensors.pressure_offset_pa": rng.choice([-1, 1]) * rng.uniform(0.4e5, 1.5e5)})
+    result = diagnose(runs, reference)
+    assert result.verdict == "pressure_sensor_offset"
+    offset = _finding(result, "pressure_sensor_offset").parameters["offset_pa"]
+    assert offset == pytest.approx(rig.number("sensors.pressure_offset_pa"), rel=0.2)
+
+
+@pytest.mark.slow
+def test_tire_relaxation_is_named_and_measured_within_20_percent(reference, tmp_path):
+    runs, rig = _campaign(reference, tmp_path, 104, lambda rng: {
+        "elements.tire_relaxation": True, "tyre.relaxation_length_m": rng.uniform(0.3, 0.7)})
+    result = diagnose(runs, reference)
+    assert result.verdict == "tire_relaxation"
+    length = _finding(result, "tire_relaxation").parameters["relaxation_length_m"]
+    assert length == pytest.approx(rig.number("tyre.relaxation_length_m"), rel=0.2)
+
+
+def test_without_gear_walk_the_gear_walk_is_rediscovered(reference, tmp_path):
+    """The paper's story: start from the single-corner model, find the ~8 Hz gear walk."""
+    runs, rig = _campaign(reference, tmp_path, 105, lambda rng: {
+        "gear_walk.stiffness_n_m_per_rad": 6.9e5 * rng.uniform(0.7, 1.4)})
+    result = diagnose(runs, reference, without=["gear_walk"])
+    assert result.verdict == "gear_walk"
+    found = _finding(result, "gear_walk").parameters
+    assert found["frequency_hz"] == pytest.approx(
+        gear_walk_key_parameters(rig)["frequency_hz"], rel=0.05)
+
+
+@pytest.mark.slow
+def test_without_drag_the_flywheel_drag_is_rediscovered(reference, tmp_path):
+    runs, rig = _campaign(reference, tmp_path, 106, lambda rng: {
+        "drag.coeff_n_s2_per_m2": rng.uniform(0.3, 0.6)})
+    result = diagnose(runs, reference, without=["drag"])
+    assert result.verdict == "drag"
+    found = _finding(result, "drag").parameters["drag_coeff_n_s2_per_m2"]
+    assert found == pytest.approx(rig.number("drag.coeff_n_s2_per_m2"), rel=0.2)
+
+
+def test_brake_fade_is_named_and_measured(reference, tmp_path):
+    runs, rig = _campaign(reference, tmp_path, 110, lambda rng: {
+        "elements.brake_fade": True, "brake.fade_fraction": rng.uniform(0.2, 0.4),
+        "brake.fade_energy_j": rng.uniform(1e6, 3e6)})
+    result = diagnose(runs, reference)
+    assert result.verdict == "brake_fade"
+    found = _finding(result, "brake_fade").parameters
+    assert found["fade_fraction"] == pytest.approx(rig.number("brake.fade_fraction"), rel=0.2)
+    assert found["fade_energy_j"] == pytest.approx(rig.number("brake.fade_energy_j"), rel=0.3)
+
+
+def test_without_actuator_dynamics_the_valve_dynamics_are_rediscovered(reference, tmp_path):
+    runs, rig = _campaign(reference, tmp_path, 111)
+    result = diagnose(runs, reference, without=["actuator_dynamics"])
+    assert result.verdict == "actuator_dynamics"
+    found = _finding(result, "actuator_dynamics").parameters["natural_frequency_hz"]
+    assert found == pytest.approx(rig.number("actuator.natural_frequency_hz"), rel=0.1)
+
+
+@pytest.mark.slow
+def test_without_load_dependent_radius_it_is_rediscovered(reference, tmp_path):
+    runs, rig = _campaign(reference, tmp_path, 112)
+    result = diagnose(runs, reference, without=["load_dependent_radius"])
+    assert result.verdict == "load_dependent_radius"
+    found = _finding(result, "load_dependent_radius").parameters
+    load = float(np.median(np.concatenate([r.vertical_load_n for r in runs
+                                           if r.name.startswith("brake")])))
+    # a and b trade off at the loads of one campaign: check the radius change they make
+    reduction = found["radius_a_m_per_n2"] * load ** 2 + found["radius_b_m_per_n"] * load
+    truth = rig.number("radius.a_m_per_n2") * load ** 2 + rig.number("radius.b_m_per_n") * load
+    assert reduction == pytest.approx(truth, rel=0.2)
+
+
+@pytest.mark.slow
+def test_without_a_calibrated_friction_curve_it_is_named(reference, tmp_path):
+    """A wet surface: the datasheet curve is far off; the candidate re-fits it."""
+    runs, rig = _campaign(reference, tmp_path, 113, lambda rng: {
+        "friction.theta1": reference.number("friction.theta1") * rng.uniform(0.6, 0.8)})
+    result = diagnose(runs, reference, without=["friction_curve"])
+    assert result.verdict == "friction_curve"
+    found = _finding(result, "friction_curve").parameters
+    assert found["theta1"] == pytest.approx(rig.number("friction.theta1"), rel=0.05)
+
+
+def test_an_effect_outside_the_catalogue_is_not_given_a_catalogue_name(reference, tmp_path):
+    """Electrical pick-up on the wheel-speed line: a line at a fixed frequency."""
+    _campaign(reference, tmp_path, 107)
+    rng = np.random.default_rng(107)
+    frequency = rng.uniform(25.0, 45.0)
+    for path in tmp_path.glob("brake_*.csv"):
+        run = read_csv(path)
+        t = run.time_s - run.time_s[0]
+        write_csv(dataclasses.replace(
+            run, wheel_speed_rad_s=run.wheel_speed_rad_s + np.sin(2 * math.pi * frequency * t)),
+            path)
+    result = diagnose(read_campaign(tmp_path).runs, reference)
+    assert [f.cause for f in result.findings] == ["unexplained"]
+    assert result.findings[0].parameters["frequency_hz"] == pytest.approx(frequency, abs=0.5)
+
+
+def test_unknown_element_to_remove_is_a_clear_error(reference, tmp_path):
+    runs, _ = _campaign(reference, tmp_path, 108)
+    with pytest.raises(DiagnosisError, match="not a model element"):
+        diagnose(runs[:1], reference, without=["gearwalk"])
+
+
+def test_cli_writes_the_contract_json_and_the_report(reference, tmp_path, capsys):
+    folder = tmp_path / "campaign"
+    _campaign(reference, folder, 109, lambda rng: {
+        "elements.actuator_delay": True, "actuator.delay_s": 0.006})
+    out = tmp_path / "diagnosis.json"
+    code = main(["diagnose", str(folder), "--json", str(out), "--report",
+                 str(tmp_path / "report"), "-o", str(tmp_path / "extended.yaml")])
+    assert code == 0
+    document = json.loads(out.read_text())
+    assert document["verdict"] == "actuator_delay"
+    finding = document["findings"][0]
+    assert {"cause", "parameters", "evidence", "fit_before", "fit_after",
+            "delta_bic"} <= set(finding)
+    assert finding["fit_after"]["pressure_pa"] > finding["fit_before"]["pressure_pa"]
+    assert set(document["baseline"]) >= {"pressure_pa", "wheel_speed_rad_s"}
+    assert (tmp_path / "report" / "index.html").exists()
+    assert "VERDICT: actuator_delay" in capsys.readouterr().out
+    assert main(["params", "--config", str(tmp_path / "extended.yaml")]) == 0
+
+
+def test_cli_diagnose_on_a_missing_folder_is_one_error_line(capsys):
+    assert main(["diagnose", "/nonexistent/campaign"]) == 2
+    assert capsys.readouterr().err.count("\n") == 1

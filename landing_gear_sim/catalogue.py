@@ -147,16 +147,23 @@ def select_runs(runs: Sequence[Run], kinds: Sequence[str]) -> list[Run]:
     return [r for r in runs if classify(r).split("_")[0] in kinds]
 
 
+def simulate_all(runs: Sequence[Run], params: RigParameters) -> list[Run]:
+    """Every run simulated with its measured input, on its own time base."""
+    return [simulate_run(run, params)[0] for run in runs]
+
+
+def scaled_error(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequence[str],
+                 scales: Scales) -> np.ndarray:
+    """Simulation minus measurement over ``channels``, divided by the noise, decimated."""
+    return np.concatenate([(getattr(sim, c) - getattr(run, c))[::DECIMATE]
+                           / scales[(run.name, c)]
+                           for run, sim in zip(runs, simulated, strict=True) for c in channels])
+
+
 def scaled_residual(runs: Sequence[Run], params: RigParameters, channels: Sequence[str],
                     scales: Scales) -> np.ndarray:
     """Simulation minus measurement over ``channels`` of ``runs``, divided by the noise."""
-    parts = []
-    for run in runs:
-        simulated, _ = simulate_run(run, params)
-        for channel in channels:
-            error = getattr(simulated, channel) - getattr(run, channel)
-            parts.append(error[::DECIMATE] / scales[(run.name, channel)])
-    return np.concatenate(parts)
+    return scaled_error(runs, simulate_all(runs, params), channels, scales)
 
 
 def switched_on(candidate: Candidate, params: RigParameters) -> RigParameters:

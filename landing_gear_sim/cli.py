@@ -66,7 +66,7 @@ def _add_params_arguments(parser: argparse.ArgumentParser, without: bool = True)
 def _params(args: argparse.Namespace) -> RigParameters:
     overrides = dict(parse_assignment(text) for text in args.set)
     params = load_parameters(args.config, overrides or None)
-    removed = getattr(args, "without", None) if args.command != "diagnose" else None
+    removed = getattr(args, "without", None)
     return params.without(*removed) if removed else params
 
 
@@ -314,7 +314,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     for problem in campaign.problems:
         _progress(f"skipped: {problem}")
     started = time.perf_counter()
-    result = diagnose(campaign.runs, _params(args), args.without,
+    result = diagnose(campaign.runs, _params(args), args.start_without,
                       lambda m: _progress(f"[{time.perf_counter() - started:5.1f} s] {m}"))
     result.problems[:0] = campaign.problems
     print(_diagnosis_summary(result))
@@ -451,6 +451,7 @@ def build_parser() -> argparse.ArgumentParser:
                       help="CSV files, bags, or campaign folders")
     _add_params_arguments(diag, without=False)
     diag.add_argument("--without", action="extend", nargs="+", default=[], metavar="ELEMENT",
+                      dest="start_without",
                       help="start from a model without these elements, e.g. gear_walk, "
                       "friction_curve (the diagnosis must then rediscover them)")
     diag.add_argument("--json", type=Path, help="write the diagnosis contract JSON here")

@@ -40,8 +40,9 @@ from .catalogue import (
     fit_candidate,
     key_parameters,
     noise_scales,
-    scaled_residual,
+    scaled_error,
     select_runs,
+    simulate_all,
     switched_on,
 )
 from .errors import LandingGearSimError
@@ -147,16 +148,16 @@ class Diagnosis:
 
 # --- fit % and information criteria -----------------------------------------------------
 
-def channel_fits(runs: Sequence[Run], params: RigParameters, channels: Sequence[str]
+def channel_fits(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequence[str]
                  ) -> dict[str, float]:
-    """Fit % per channel pooled over ``runs`` (each run's own mean removed)."""
+    """Fit % per channel of ``simulated`` against ``runs``, pooled (each run's own mean
+    removed)."""
     errors: dict[str, float] = dict.fromkeys(channels, 0.0)
     spreads: dict[str, float] = dict.fromkeys(channels, 0.0)
-    for run in runs:
-        simulated, _ = simulate_run(run, params)
+    for run, sim in zip(runs, simulated, strict=True):
         for c in channels:
             y = getattr(run, c)
-            errors[c] += float(np.sum((y - getattr(simulated, c)) ** 2))
+            errors[c] += float(np.sum((y - getattr(sim, c)) ** 2))
             spreads[c] += float(np.sum((y - y.mean()) ** 2))
     return {c: round(100.0 * (1.0 - math.sqrt(errors[c] / spreads[c])), 2)
             for c in channels if spreads[c] > 0}
@@ -213,8 +214,6 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
                     signatures: Sequence[Signature]) -> _Scored:
     """Fit ``candidate`` and its null on the fitting runs; compare both on held-out runs."""
     fit_runs, held_runs = split_runs(candidate, runs)
-    fit_runs = select_runs(fit_runs, candidate.runs) or fit_runs
-    # the model may already have been re-tuned by an accepted candidate: start there
     sub = _as_fitting(candidate, fit_runs)
     with_it = fit_candidate(sub, fit_runs, model, datasheet, scales=scales)
     without = fit_candidate(sub, fit_runs, model, datasheet, null=True, scales=scales)
@@ -225,12 +224,13 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
     before: dict[str, float] = {}
     after: dict[str, float] = {}
     if held_runs:
-        held_sub = _as_fitting(candidate, held_runs)
-        r_with = scaled_residual(held_runs, with_it.params, held_sub.channels, scales)
-        r_without = scaled_residual(held_runs, without.params, held_sub.channels, scales)
-        held_delta = log_ratio(r_with, r_without)
-        before = channel_fits(held_runs, without.params, held_sub.channels)
-        after = channel_fits(held_runs, with_it.params, held_sub.channels)
+        channels = candidate.channels
+        sim_with = simulate_all(held_runs, with_it.params)
+        sim_without = simulate_all(held_runs, without.params)
+        held_delta = log_ratio(scaled_error(held_runs, sim_with, channels, scales),
+                               scaled_error(held_runs, sim_without, channels, scales))
+        before = channel_fits(held_runs, sim_without, channels)
+        after = channel_fits(held_runs, sim_with, channels)
     gain = float(np.mean([after[c] - before[c] for c in after])) if after else 0.0
     at_bound = _at_bound(candidate, with_it)
     accepted = (delta_bic < BIC_THRESHOLD and held_delta is not None
@@ -259,8 +259,8 @@ def _at_bound(candidate: Candidate, fit: CandidateFit) -> bool:
 
 
 def _as_fitting(candidate: Candidate, runs: Sequence[Run]) -> Candidate:
-    """The candidate restricted to the kinds of ``runs`` (braking runs used to check an
-    actuator effect are compared on pressure only)."""
+    """The candidate fitted on the kinds of ``runs`` (its own kinds, or when the campaign
+    has none of those, the kinds it is otherwise checked on)."""
     kinds = tuple(sorted({classify(r).split("_")[0] for r in runs}))
     return replace(candidate, runs=kinds)
 
@@ -302,7 +302,7 @@ CORRELATION_BANDS = 3.0  # ... and that many times its noise band
 LINE_BAND_HZ = (2.0, 200.0)
 
 
-def _regressors(run: Run, simulated: Run, params: RigParameters) -> dict[str, np.ndarray]:
+def _regressors(run: Run, params: RigParameters) -> dict[str, np.ndarray]:
     speed = run.flywheel_speed_rad_s * params.number("flywheel.radius_m")
     wheel = run.wheel_speed_rad_s * params.number("wheel.unloaded_radius_m")
     smooth_pressure = np.convolve(run.pressure_pa, np.ones(20) / 20, mode="same")
@@ -320,20 +320,19 @@ def find_signatures(runs: Sequence[Run], params: RigParameters) -> list[Signatur
     for run in runs:
         simulated, _ = simulate_run(run, params)
         kind = classify(run)
-        channels = ["pressure_pa"] + ([] if kind.startswith("actuator")
-                                      else ["wheel_speed_rad_s"])
+        actuator = kind.startswith("actuator")
+        channels = ["pressure_pa"] + ([] if actuator else ["wheel_speed_rad_s"])
+        window = np.ones(len(run), bool) if actuator else braking_window(run, params)
         for channel in channels:
-            error = getattr(run, channel) - getattr(simulated, channel)
-            window = (np.ones(len(run), bool) if kind.startswith("actuator")
-                      else braking_window(run, params))
             if window.sum() < 2048:
                 continue
+            error = getattr(run, channel) - getattr(simulated, channel)
             for peak in rs.spectrum(error[window], run.rate_hz, band_hz=LINE_BAND_HZ).peaks[:3]:
                 lines.setdefault(channel, []).append((run.name, peak.frequency_hz, peak.ratio))
             if channel == "wheel_speed_rad_s":
                 for c in rs.regressor_correlations(error[window],
                                                    {k: v[window] for k, v in
-                                                    _regressors(run, simulated, params).items()}):
+                                                    _regressors(run, params).items()}):
                     correlations.setdefault(c.name, []).append((run.name, c.value, c.band))
         if np.ptp(run.pressure_pa) > 5e5:
             lags.append((run.name, rs.lag_samples(run.pressure_pa, simulated.pressure_pa, 50)
@@ -528,11 +527,12 @@ def _recalibrate(runs: Sequence[Run], start: RigParameters, accepted: list[_Scor
 
 def _baseline(runs: Sequence[Run], params: RigParameters) -> dict[str, float]:
     """Fit % per channel: pressure over every run, the rest over the braking runs."""
-    fits = channel_fits(runs, params, ("pressure_pa",))
-    braking = select_runs(runs, ("brake",))
+    simulated = simulate_all(runs, params)
+    fits = channel_fits(runs, simulated, ("pressure_pa",))
+    braking = [i for i, r in enumerate(runs) if classify(r).startswith("brake")]
     if braking:
-        fits.update(channel_fits(braking, params, tuple(c for c in CHANNELS
-                                                        if c != "pressure_pa")))
+        fits.update(channel_fits([runs[i] for i in braking], [simulated[i] for i in braking],
+                                 tuple(c for c in CHANNELS if c != "pressure_pa")))
     return fits
 
 

@@ -1,5 +1,6 @@
 # Two set-up commands on a fresh machine (each makes its own virtual environment):
-#   make demo   - simulate the reference rig, calibrate and diagnose synthetic campaigns
+#   make demo   - simulate the reference rig, run the ROS 2 node graph and record a bag,
+#                 calibrate and diagnose synthetic campaigns
 #   make test   - lint and run the test suite
 PYTHON ?= python3
 VENV ?= .venv
@@ -18,11 +19,12 @@ $(STAMP): setup.py setup.cfg
 	touch $(STAMP)
 
 demo: $(STAMP)
-	rm -rf out/brake_const_30bar_bag
+	rm -rf out/brake_const_30bar_bag out/rig_osc_low
 	$(BIN)/landing-gear-sim simulate --pressure-bar 30 -o out/brake_const_30bar.csv --bag out/brake_const_30bar_bag
 	$(BIN)/landing-gear-sim simulate --pressure-bar 45 -o out/brake_const_45bar.csv
 	$(BIN)/landing-gear-sim simulate --profile osc-low -o out/brake_osc_low.csv
 	$(BIN)/landing-gear-sim bode -o out/bode.png
+	$(BIN)/landing-gear-sim rig --profile osc-low --bag out/rig_osc_low
 	rm -rf out/campaign
 	$(BIN)/landing-gear-sim campaign out/campaign --seed 1
 	$(BIN)/landing-gear-sim identify out/campaign -o out/calibrated.yaml
@@ -32,7 +34,7 @@ demo: $(STAMP)
 	$(BIN)/landing-gear-sim diagnose out/campaign_delay --json out/diagnosis.json --report out/diagnosis -o out/extended.yaml
 
 lint: $(STAMP)
-	$(BIN)/ruff check landing_gear_sim antiskid msg_tools test bench
+	$(BIN)/ruff check landing_gear_sim antiskid msg_tools test bench launch
 
 test: lint
 	$(BIN)/python -m pytest -q -n 2 test
@@ -43,6 +45,7 @@ test-slow: lint
 bench: $(STAMP)
 	$(BIN)/python bench/run.py
 	$(BIN)/python bench/identify.py
+	$(BIN)/python bench/graph.py
 
 clean:
 	rm -rf $(VENV) out build install log .pytest_cache

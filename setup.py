@@ -5,6 +5,7 @@ from glob import glob
 from setuptools import find_packages, setup
 
 PACKAGE = "landing_gear_sim"
+NODES = ("plant", "actuator", "loading_device", "profile", "recorder", "replay")
 
 setup(
     name=PACKAGE,
@@ -18,6 +19,7 @@ setup(
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),
         (f"share/{PACKAGE}/config", glob("config/*.yaml")),
+        (f"share/{PACKAGE}/launch", glob("launch/*.launch.py")),
     ],
     install_requires=[
         "numpy>=1.24",
@@ -53,6 +55,8 @@ setup(
             "landing-gear-sim = landing_gear_sim.cli:main",
             "simulate = landing_gear_sim.cli:simulate_main",
             "bode = landing_gear_sim.cli:bode_main",
+            # the nodes: `ros2 run landing_gear_sim <name>` after colcon build
+            *(f"{node} = landing_gear_sim.nodes.{node}:main" for node in NODES),
         ],
     },
 )

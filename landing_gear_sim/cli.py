@@ -6,6 +6,7 @@ Every user error ends as one line ``landing-gear-sim: error: ...`` and exit code
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -20,6 +21,7 @@ from msg_tools.errors import RunFormatError
 from . import scenario as sc
 from .errors import LandingGearSimError
 from .parameters import ELEMENTS, SPECS, RigParameters, load_parameters, parse_assignment
+from .runspec import PROFILES, RunSpec, build_scenario
 
 if TYPE_CHECKING:
     from msg_tools.run import Run
@@ -29,27 +31,8 @@ if TYPE_CHECKING:
 
 PROG = "landing-gear-sim"
 
-# profile name -> (builder, wheel on the flywheel?, actuator-test duration [s])
-PROFILES: dict[str, tuple[Callable[[argparse.Namespace, RigParameters], sc.Profile], bool, float]]
-PROFILES = {
-    "constant": (lambda a, p: sc.constant(_constant_level(a, p)), True, 0.0),
-    "osc-low": (lambda a, p: sc.oscillating(**sc.OSC_LOW), True, 0.0),
-    "osc-high": (lambda a, p: sc.oscillating(**sc.OSC_HIGH), True, 0.0),
-    "ramp": (lambda a, p: sc.quasi_static_ramp(p.number("actuator.max_current_a")), False, 20.0),
-    "steps": (lambda a, p: sc.steps(), False, 8.0),
-    "sweep": (lambda a, p: sc.sine_sweep(), False, 20.0),
-    "steps-sweep": (lambda a, p: sc.steps_then_sweep(), False, 28.0),
-}
-
-
 def _progress(message: str) -> None:
     print(f"[{PROG}] {message}", file=sys.stderr, flush=True)
-
-
-def _constant_level(args: argparse.Namespace, params: RigParameters) -> float:
-    if args.current_a is not None:
-        return float(args.current_a)
-    return sc.current_for_pressure(params, args.pressure_bar * 1e5)
 
 
 def _add_params_arguments(parser: argparse.ArgumentParser, without: bool = True) -> None:
@@ -63,6 +46,21 @@ def _add_params_arguments(parser: argparse.ArgumentParser, without: bool = True)
                             help=f"switch an element off ({', '.join(ELEMENTS)})")
 
 
+def _add_run_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--profile", choices=[*PROFILES, "file"], default="constant",
+                        help="valve current profile (default: constant)")
+    parser.add_argument("--pressure-bar", type=float, default=30.0,
+                        help="constant profile: target pressure (default 30 bar)")
+    parser.add_argument("--current-a", type=float, help="constant profile: current instead")
+    parser.add_argument("--file", type=Path,
+                        help="--profile file: run (CSV or bag) whose current to use")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--actuator-only", action="store_true", help="wheel off the flywheel")
+    where.add_argument("--rig", action="store_true", help="wheel on the flywheel")
+    parser.add_argument("--duration", type=float, help="input duration [s] (actuator tests)")
+    parser.add_argument("--rate", type=float, help="output rate [Hz] (default from config)")
+
+
 def _params(args: argparse.Namespace) -> RigParameters:
     overrides = dict(parse_assignment(text) for text in args.set)
     params = load_parameters(args.config, overrides or None)
@@ -71,31 +69,17 @@ def _params(args: argparse.Namespace) -> RigParameters:
 
 
 def _build_scenario(args: argparse.Namespace, params: RigParameters) -> sc.Scenario:
-    rate = args.rate or None
-    if args.profile == "file":
-        if args.file is None:
-            raise LandingGearSimError("--profile file needs --file RUN.csv")
-        profile, duration = sc.from_file(args.file)
-        contact = not args.actuator_only
-        name = Path(args.file).stem + "_sim"
-    else:
-        build, contact, duration = PROFILES[args.profile]
-        profile = build(args, params)
-        contact = (contact or args.rig) and not args.actuator_only
-        name = args.profile.replace("-", "_")
-        if args.profile == "constant":
-            name = f"brake_const_{args.pressure_bar:g}bar" if args.current_a is None \
-                else f"brake_const_{args.current_a:g}A"
-    if args.duration:
-        duration = args.duration
-    if contact:
-        if args.profile == "file":  # a recorded run already holds its braking start
-            times = sc.sample_times(duration, rate or params.number("simulation.output_rate_hz"))
-            return sc.Scenario(name, profile(times), 1.0 / (times[1] - times[0]), True,
-                               params.number("rig_test.initial_speed_m_s"),
-                               params.number("rig_test.stop_speed_m_s"), "replayed current")
-        return sc.rig_test(params, profile, name, rate)
-    return sc.actuator_test(params, profile, duration or 10.0, name, rate)
+    if args.profile == "file" and args.file is None:
+        raise LandingGearSimError("--profile file needs --file RUN")
+    return build_scenario(_run_spec(args), params)
+
+
+def _run_spec(args: argparse.Namespace) -> RunSpec:
+    contact = "actuator" if args.actuator_only else "rig" if args.rig else "auto"
+    return RunSpec(profile=args.profile, pressure_pa=args.pressure_bar * 1e5,
+                   current_a=math.nan if args.current_a is None else args.current_a,
+                   file=str(args.file or ""), contact=contact,
+                   duration_s=args.duration or 0.0, rate_hz=args.rate or 0.0)
 
 
 def _summary(result: SimulationResult) -> str:
@@ -139,6 +123,51 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         plot = plot_simulation(result, args.plot or output.with_suffix(".png"))
         print(f"  plot: {plot}")
     return 0
+
+
+def cmd_rig(args: argparse.Namespace) -> int:
+    from .graph import GraphOptions
+    from .launcher import run_graph
+
+    params = _params(args)
+    spec = _run_spec(args)
+    if args.replay is not None:
+        spec = RunSpec(profile="file", file=str(args.replay), contact=spec.contact,
+                       rate_hz=spec.rate_hz)
+    scenario = build_scenario(spec, params)  # fail here, not in five processes
+    bag = None if args.no_bag else args.bag or Path("out") / "rig" / (
+        f"{scenario.name}_{time.strftime('%Y%m%d-%H%M%S')}")
+    if bag is not None and bag.exists():
+        raise LandingGearSimError(f"{bag}: exists already; remove it or choose another --bag")
+    options = GraphOptions(run=spec, clock=args.clock, bag=bag, storage=args.storage,
+                           sensor_noise=args.noise, timeout_s=args.timeout,
+                           safe_pressure_pa=args.safe_pressure_bar * 1e5,
+                           replay=args.replay is not None)
+    _progress(f"{scenario.name}: {args.clock} graph, up to {scenario.duration_s:.1f} s at "
+              f"{scenario.rate_hz:g} Hz")
+    started = time.perf_counter()
+    outcome = run_graph(options, params, _progress)
+    wall = time.perf_counter() - started
+    print(f"graph run: {wall:.1f} s wall; node exit codes: "
+          + ", ".join(f"{name} {code}" for name, code in outcome.exit_codes.items()))
+    if bag is not None:
+        print(_bag_summary(bag))
+    if outcome.interrupted:
+        print(f"{PROG}: interrupted; the bag holds the run up to the stop", file=sys.stderr)
+        return 130
+    return 0 if outcome.ok else 1
+
+
+def _bag_summary(bag: Path) -> str:
+    from msg_tools.bag_io import read_bag
+
+    try:
+        run = read_bag(bag)
+    except RunFormatError as exc:
+        return f"bag: {bag} (not readable as a run: {exc})"
+    return (f"bag: {bag} ({len(run)} samples, {run.time_s[-1]:.3f} s, max pressure "
+            f"{run.pressure_pa.max() / 1e5:.2f} bar, flywheel {run.flywheel_speed_rad_s[0]:.1f}"
+            f" -> {run.flywheel_speed_rad_s[-1]:.1f} rad/s)")
 
 
 def cmd_bode(args: argparse.Namespace) -> int:
@@ -380,17 +409,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     sim = sub.add_parser("simulate", help="simulate a rig test; write CSV (+ bag) and a plot")
     _add_params_arguments(sim)
-    sim.add_argument("--profile", choices=[*PROFILES, "file"], default="constant",
-                     help="valve current profile (default: constant)")
-    sim.add_argument("--pressure-bar", type=float, default=30.0,
-                     help="constant profile: target pressure (default 30 bar)")
-    sim.add_argument("--current-a", type=float, help="constant profile: current instead")
-    sim.add_argument("--file", type=Path, help="--profile file: run CSV whose current to use")
-    where = sim.add_mutually_exclusive_group()
-    where.add_argument("--actuator-only", action="store_true", help="wheel off the flywheel")
-    where.add_argument("--rig", action="store_true", help="wheel on the flywheel")
-    sim.add_argument("--duration", type=float, help="input duration [s] (actuator tests)")
-    sim.add_argument("--rate", type=float, help="output rate [Hz] (default from config)")
+    _add_run_arguments(sim)
     sim.add_argument("--noise-seed", type=int, help="seed of the sensor noise (sensors.*)")
     sim.add_argument("-o", "--output", type=Path, help="CSV path (default out/<name>.csv)")
     sim.add_argument("--bag", type=Path, help="also write a rosbag2 folder here")
@@ -398,6 +417,23 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--plot", type=Path, help="PNG path (default next to the CSV)")
     sim.add_argument("--no-plot", action="store_true")
     sim.set_defaults(func=cmd_simulate)
+
+    rig = sub.add_parser("rig", help="bring the ROS 2 node graph up for one run; record a bag")
+    _add_params_arguments(rig)
+    _add_run_arguments(rig)
+    rig.add_argument("--replay", type=Path, metavar="RUN",
+                     help="re-run a recorded rig test: its current drives the simulated graph")
+    rig.add_argument("--clock", choices=["lockstep", "realtime"], default="lockstep",
+                     help="lockstep: sim time, deterministic (default); realtime: wall clock")
+    rig.add_argument("--bag", type=Path, help="bag folder (default out/rig/<run>_<time>)")
+    rig.add_argument("--no-bag", action="store_true", help="run without the recorder")
+    rig.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
+    rig.add_argument("--noise", action="store_true", help="add the sensors.* noise")
+    rig.add_argument("--timeout", type=float, default=10.0,
+                     help="lockstep: seconds to wait for a silent node before holding its input")
+    rig.add_argument("--safe-pressure-bar", type=float, default=0.0,
+                     help="brake pressure applied once the actuator is lost (default 0)")
+    rig.set_defaults(func=cmd_rig)
 
     bode = sub.add_parser("bode", help="frequency responses G_lambda, G_eta (paper Fig. 7)")
     _add_params_arguments(bode)

@@ -157,10 +157,10 @@ def from_samples(time_s: np.ndarray, current_a: np.ndarray, name: str = "file") 
 
 
 def from_file(path: Path) -> tuple[Profile, float]:
-    """The recorded current of a run file (contract CSV); returns the profile and its duration."""
-    from msg_tools.csv_io import read_csv  # run I/O lives in msg_tools
+    """The recorded current of a run (CSV or bag); returns the profile and its duration."""
+    from msg_tools.io import read_run  # run I/O lives in msg_tools
 
-    run = read_csv(Path(path))
+    run = read_run(Path(path))
     profile = from_samples(run.time_s, logged_to_held(run.current_a), str(path))
     return profile, float(run.time_s[-1] - run.time_s[0]) + 1.0 / run.rate_hz
 

@@ -69,12 +69,16 @@ def read_csv(path: Path, name: str | None = None, mapping: Mapping | None = None
         text = path.read_text()
     except OSError as exc:
         raise RunFormatError(f"{path}: cannot read ({exc.strerror})") from None
+    if not text.strip():
+        raise RunFormatError(f"{path}: the file is empty")
     header, _, body = text.partition("\n")
     columns = [c.strip() for c in header.split(",")]
     missing = [source for source, _ in mapping.values() if source not in columns]
     if missing:
         raise RunFormatError(f"{path}: missing column(s) {', '.join(missing)} "
                              f"(found {', '.join(columns)})")
+    if not body.strip():
+        raise RunFormatError(f"{path}: expected >= 2 rows of {len(columns)} values, found none")
     try:
         table = np.loadtxt(io.StringIO(body), delimiter=",", ndmin=2)
     except ValueError as exc:

@@ -58,7 +58,7 @@ def test_replaying_a_recorded_current_reproduces_the_run(tmp_path):
     (["simulate", "--set", "friction.thta1=1"], "did you mean 'friction.theta1'"),
     (["simulate", "--config", "/no/such.yaml"], "/no/such.yaml: cannot read"),
     (["simulate", "--profile", "file"], "--profile file needs --file"),
-    (["simulate", "--profile", "file", "--file", "/no/run.csv"], "/no/run.csv: cannot read"),
+    (["simulate", "--profile", "file", "--file", "/no/run.csv"], "/no/run.csv: no such file"),
 ])
 def test_bad_input_is_one_error_line_and_exit_2(argv, fragment, capsys, tmp_path):
     assert main([*argv, "-o", str(tmp_path / "x.csv")]) == 2

@@ -1,0 +1,55 @@
+"""``actuator`` node: valve static map + A(s); brake current reference → brake pressure.
+
+The j-th current of the run is the command held over step j (the controller or
+profile sends exactly one per plant sample), so its pressure is stamped (j+1)·h.
+"""
+
+from __future__ import annotations
+
+from sensor_msgs.msg import FluidPressure
+from std_msgs.msg import Float64
+
+from msg_tools.contract import ATMOSPHERE_PA, TOPIC_CURRENT
+
+from ..blocks import ActuatorBlock, step_time
+from ..graph import TOPIC_HYDRAULIC
+from ..runspec import build_scenario
+from .common import (
+    DATA_QOS,
+    GraphNode,
+    Handshake,
+    announce_ready,
+    lockstep,
+    main_for,
+    rig_parameters,
+    run_spec,
+    to_stamp,
+)
+
+
+class ActuatorNode(GraphNode):
+    def __init__(self) -> None:
+        super().__init__("actuator")
+        params = rig_parameters(self)
+        lockstep(self)  # declared for a uniform graph; the actuator reacts the same in both
+        self._step_s = build_scenario(run_spec(self), params).step_s
+        self._block = ActuatorBlock(params, self._step_s)
+        self._count = 0
+        self._message = FluidPressure()
+        self._message.header.frame_id = "brake"
+        self._out = self.publisher(FluidPressure, TOPIC_HYDRAULIC, DATA_QOS)
+        current = self.subscription(Float64, TOPIC_CURRENT, self._on_current, DATA_QOS)
+        Handshake(self, {TOPIC_HYDRAULIC: self._out}, [current], announce_ready(self))
+
+    def _on_current(self, message: Float64) -> None:
+        pressure = self._block.step(message.data)
+        self._count += 1
+        self._message.header.stamp = to_stamp(step_time(self._count, self._step_s))
+        self._message.fluid_pressure = pressure + ATMOSPHERE_PA
+        self._out.publish(self._message)
+
+
+main = main_for(ActuatorNode)
+
+if __name__ == "__main__":
+    main()

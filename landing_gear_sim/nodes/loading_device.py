@@ -1,0 +1,51 @@
+"""``loading_device`` node: lift map + servo; flywheel speed at t_k → vertical force at t_{k+1}."""
+
+from __future__ import annotations
+
+from geometry_msgs.msg import Vector3Stamped
+from sensor_msgs.msg import JointState
+
+from msg_tools.contract import TOPIC_FLYWHEEL
+
+from ..blocks import LoadingBlock, step_time
+from ..graph import TOPIC_LOAD
+from ..runspec import build_scenario
+from .common import (
+    DATA_QOS,
+    GraphNode,
+    Handshake,
+    announce_ready,
+    lockstep,
+    main_for,
+    rig_parameters,
+    run_spec,
+    step_of,
+    to_stamp,
+)
+
+
+class LoadingDeviceNode(GraphNode):
+    def __init__(self) -> None:
+        super().__init__("loading_device")
+        params = rig_parameters(self)
+        lockstep(self)
+        scenario = build_scenario(run_spec(self), params)
+        self._rate_hz, self._step_s = scenario.rate_hz, scenario.step_s
+        self._block = LoadingBlock(params, scenario.step_s, scenario.contact)
+        self._message = Vector3Stamped()
+        self._message.header.frame_id = "gear"
+        self._out = self.publisher(Vector3Stamped, TOPIC_LOAD, DATA_QOS)
+        speed = self.subscription(JointState, TOPIC_FLYWHEEL, self._on_speed, DATA_QOS)
+        Handshake(self, {TOPIC_LOAD: self._out}, [speed], announce_ready(self))
+
+    def _on_speed(self, message: JointState) -> None:
+        step = step_of(message.header.stamp, self._rate_hz)
+        self._message.vector.z = self._block.step(step, message.velocity[0])
+        self._message.header.stamp = to_stamp(step_time(step + 1, self._step_s))
+        self._out.publish(self._message)
+
+
+main = main_for(LoadingDeviceNode)
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,29 @@
+"""``ros2 launch landing_gear_sim rig.launch.py [profile:=osc-low] [clock:=realtime] ...``
+
+Thin on purpose: the nodes, their parameters and links come from
+``landing_gear_sim.graph.describe``, the same description ``landing-gear-sim rig``
+starts without a ROS install. Arguments: see ``graph.LAUNCH_ARGUMENTS``.
+"""
+
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument, OpaqueFunction
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node
+
+from landing_gear_sim.graph import LAUNCH_ARGUMENTS, PACKAGE, describe, options_from_arguments
+from landing_gear_sim.launcher import ros_environment
+
+
+def _nodes(context):
+    values = {name: LaunchConfiguration(name).perform(context) for name in LAUNCH_ARGUMENTS}
+    options, params_file = options_from_arguments(values)
+    env = ros_environment({})  # DDS on this machine, a private domain unless the user set one
+    return [Node(package=PACKAGE, executable=node.name, name=node.name, output="screen",
+                 parameters=[str(params_file), node.parameters], additional_env=env)
+            for node in describe(options)]
+
+
+def generate_launch_description():
+    arguments = [DeclareLaunchArgument(name, default_value=default, description=text)
+                 for name, (default, text) in LAUNCH_ARGUMENTS.items()]
+    return LaunchDescription([*arguments, OpaqueFunction(function=_nodes)])

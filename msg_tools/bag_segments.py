@@ -1,0 +1,123 @@
+"""A rosbag2 written in closed segments, so that a crash loses at most the open one.
+
+The caller decides where a segment ends (:meth:`SegmentedBagWriter.roll`), so that
+the same messages written in the same order give the same files. Each segment is a
+complete storage file written by ``rosbags``; when a segment closes it is moved
+into the bag folder and ``metadata.yaml`` is rewritten (atomically) to list every
+closed segment. A reader (``rosbags``, ``ros2 bag info/play``, Foxglove
+via the storage files) therefore always sees a valid bag: after ``SIGKILL`` it holds
+everything up to the last closed segment. The open segment lives in a hidden
+``.open_segment`` folder inside the bag and is never listed.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+from typing import Any
+
+import yaml
+from rosbags.rosbag2 import Writer
+
+from .bag_io import BAG_VERSION, STORAGE, TYPESTORE
+from .errors import RunFormatError
+
+OPEN_SEGMENT = ".open_segment"
+META = "rosbag2_bagfile_information"
+
+
+class SegmentedBagWriter:
+    """Write raw CDR messages into a bag made of segments closed by :meth:`roll`.
+
+    Args:
+        path: new bag folder (must not exist).
+        topics: ``{topic: message type}``, e.g.
+            ``{"/rig/brake/current_ref": "std_msgs/msg/Float64"}``.
+        storage: ``mcap`` or ``sqlite3``.
+    """
+
+    def __init__(self, path: Path, topics: dict[str, str], storage: str = "mcap") -> None:
+        if storage not in STORAGE:
+            raise RunFormatError(f"unknown bag storage {storage!r}; use mcap or sqlite3")
+        self.path = Path(path)
+        if self.path.exists():
+            raise RunFormatError(f"{self.path}: exists already, not overwriting")
+        self.path.mkdir(parents=True)
+        self._topics = dict(topics)
+        self._storage = storage
+        self._closed: list[dict[str, Any]] = []
+        self._writer: Writer | None = None
+        self._connections: dict[str, Any] = {}
+        self._count = 0
+
+    @property
+    def message_count(self) -> int:
+        """Messages in closed segments (what a reader sees now)."""
+        return sum(segment["message_count"] for segment in self._closed)
+
+    def write(self, topic: str, log_time_ns: int, raw: bytes) -> None:
+        """Append one serialized message to the open segment."""
+        if self._writer is None:
+            self._open()
+        self._writer.write(self._connections[topic], log_time_ns, raw)  # type: ignore[union-attr]
+        self._count += 1
+
+    def roll(self) -> None:
+        """Close the open segment (readers see it from now on); the next write opens one."""
+        if self._writer is not None:
+            self._close_segment()
+
+    def close(self) -> None:
+        """Close the open segment; the bag is complete. Safe to call twice."""
+        if self._writer is not None:
+            self._close_segment()
+        if not self._closed:
+            self._open()  # an empty run still leaves a readable bag
+            self._close_segment(keep_empty=True)
+
+    def _open(self) -> None:
+        folder = self.path / OPEN_SEGMENT
+        shutil.rmtree(folder, ignore_errors=True)
+        writer = Writer(folder, version=BAG_VERSION, storage_plugin=STORAGE[self._storage])
+        writer.open()
+        self._connections = {topic: writer.add_connection(topic, kind, typestore=TYPESTORE)
+                             for topic, kind in self._topics.items()}
+        self._writer, self._count = writer, 0
+
+    def _close_segment(self, keep_empty: bool = False) -> None:
+        writer, self._writer = self._writer, None
+        writer.close()  # type: ignore[union-attr]
+        folder = self.path / OPEN_SEGMENT
+        if self._count or keep_empty:
+            info = yaml.safe_load((folder / "metadata.yaml").read_text())[META]
+            source = folder / info["relative_file_paths"][0]
+            name = f"{self.path.name}_{len(self._closed)}{source.suffix}"
+            os.replace(source, self.path / name)
+            info["relative_file_paths"], info["files"][0]["path"] = [name], name
+            self._closed.append(info)
+            self._write_metadata()
+        shutil.rmtree(folder, ignore_errors=True)
+
+    def _write_metadata(self) -> None:
+        merged = dict(self._closed[0])
+        with_data = [s for s in self._closed if s["message_count"]] or self._closed
+        start = min(s["starting_time"]["nanoseconds_since_epoch"] for s in with_data)
+        end = max(s["starting_time"]["nanoseconds_since_epoch"] + s["duration"]["nanoseconds"]
+                  for s in with_data)
+        merged["starting_time"] = {"nanoseconds_since_epoch": start}
+        merged["duration"] = {"nanoseconds": end - start}
+        merged["message_count"] = self.message_count
+        merged["relative_file_paths"] = [s["relative_file_paths"][0] for s in self._closed]
+        merged["files"] = [s["files"][0] for s in self._closed]
+        counts: dict[str, int] = {}
+        for segment in self._closed:
+            for entry in segment["topics_with_message_count"]:
+                name = entry["topic_metadata"]["name"]
+                counts[name] = counts.get(name, 0) + entry["message_count"]
+        merged["topics_with_message_count"] = [
+            {**entry, "message_count": counts[entry["topic_metadata"]["name"]]}
+            for entry in self._closed[0]["topics_with_message_count"]]
+        temporary = self.path / "metadata.yaml.tmp"
+        temporary.write_text(yaml.safe_dump({META: merged}, sort_keys=False))
+        os.replace(temporary, self.path / "metadata.yaml")

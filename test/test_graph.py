@@ -1,0 +1,216 @@
+"""The graph, without starting it: blocks, description, launch file, command lines, bag segments."""
+
+from __future__ import annotations
+
+import runpy
+import sys
+import types
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from rosbags.rosbag2 import Reader
+
+from landing_gear_sim.blocks import ActuatorBlock, LoadingBlock, PlantBlock
+from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.graph import (
+    LAUNCH_ARGUMENTS,
+    RECORDED_TOPICS,
+    TOPIC_CLOCK,
+    TOPIC_RUN_END,
+    GraphOptions,
+    describe,
+    options_from_arguments,
+)
+from landing_gear_sim.integrate import simulate
+from landing_gear_sim.launcher import format_value, node_command, ros_environment
+from landing_gear_sim.runspec import RunSpec, build_scenario
+from msg_tools.bag_io import TYPESTORE, read_bag
+from msg_tools.bag_segments import OPEN_SEGMENT, SegmentedBagWriter
+from msg_tools.contract import ATMOSPHERE_PA, TOPIC_TYPES
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_blocks_stepped_as_the_nodes_do_reproduce_the_offline_run(reference):
+    """One call per message, through the message units (absolute Pa, rad/s), as the graph."""
+    scenario = build_scenario(RunSpec(profile="osc-low"), reference)
+    scenario = type(scenario)(scenario.name, scenario.current_a[:3000], scenario.rate_hz, True,
+                              scenario.initial_speed_m_s, scenario.stop_speed_m_s)
+    offline = simulate(reference, scenario).to_run()
+    plant = PlantBlock(reference, scenario)
+    actuator = ActuatorBlock(reference, scenario.step_s)
+    loading = LoadingBlock(reference, scenario.step_s, scenario.contact)
+    rows = []
+    while True:
+        sample = plant.sample()
+        rows.append([sample.pressure_pa, sample.wheel_speed_rad_s, sample.vertical_load_n])
+        if plant.finished():
+            break
+        absolute = actuator.step(scenario.current_a[sample.step]) + ATMOSPHERE_PA
+        load = loading.step(sample.step, sample.flywheel_speed_rad_s)
+        plant.advance(absolute - ATMOSPHERE_PA, load)
+    graph = np.array(rows)
+    expected = np.column_stack([offline.pressure_pa, offline.wheel_speed_rad_s,
+                                offline.vertical_load_n])
+    assert graph.shape == expected.shape
+    np.testing.assert_allclose(graph, expected, rtol=1e-12, atol=1e-6)
+
+
+def test_every_subscribed_topic_has_one_publisher_in_the_graph(tmp_path):
+    nodes = describe(GraphOptions(bag=tmp_path / "bag"))
+    publishers = {t: [n.name for n in nodes if t in n.publishes]
+                  for n in nodes for t in n.subscribes}
+    assert all(len(names) == 1 for names in publishers.values()), publishers
+    assert [n.name for n in nodes] == ["plant", "actuator", "loading_device", "profile", "recorder"]
+
+
+def test_the_plant_waits_for_every_peer_and_each_node_for_its_readers(tmp_path):
+    nodes = {n.name: n for n in describe(GraphOptions(bag=tmp_path / "bag"))}
+    assert nodes["plant"].parameters["peers"] == ["actuator", "loading_device", "profile",
+                                                  "recorder"]
+    expected = dict(item.split("=") for item in nodes["plant"].parameters["expected_subscribers"])
+    # wheel: profile + recorder; flywheel: loading device + recorder; latched/clock not awaited
+    assert expected == {"/rig/wheel/joint_state": "2", "/rig/flywheel/joint_state": "2",
+                        "/rig/brake/pressure": "1", "/rig/load_cell/wrench": "1"}
+    assert TOPIC_CLOCK not in expected and TOPIC_RUN_END not in expected
+    assert nodes["profile"].parameters["expected_subscribers"] == ["/rig/brake/current_ref=2"]
+    assert set(nodes["recorder"].subscribes) == set(RECORDED_TOPICS)
+
+
+def test_without_a_bag_there_is_no_recorder_and_nobody_waits_for_one():
+    nodes = {n.name: n for n in describe(GraphOptions())}
+    assert "recorder" not in nodes
+    assert nodes["profile"].parameters["expected_subscribers"] == ["/rig/brake/current_ref=1"]
+
+
+def test_a_replay_graph_takes_the_current_from_the_replay_node(tmp_path):
+    run = RunSpec(profile="file", file=str(tmp_path / "run.csv"))
+    names = [n.name for n in describe(GraphOptions(run=run, replay=True))]
+    assert "replay" in names and "profile" not in names
+    with pytest.raises(LandingGearSimError, match="run file"):
+        GraphOptions(replay=True)
+
+
+def test_all_nodes_of_a_graph_build_the_same_run(tmp_path):
+    nodes = describe(GraphOptions(run=RunSpec(profile="constant", pressure_pa=20e5)))
+    runs = [{k: v for k, v in n.parameters.items() if k.startswith("run.")} for n in nodes
+            if n.name in ("plant", "actuator", "loading_device", "profile")]
+    assert all(r == runs[0] for r in runs) and runs[0]["run.pressure_pa"] == 20e5
+
+
+@pytest.mark.parametrize(("value", "text"), [
+    (True, "true"), (2.0, "2.0"), ("osc-low", "'osc-low'"), ("it's", "'it''s'"),
+    (["a=1", "b=2"], "['a=1', 'b=2']"), ([], "['']"),
+])
+def test_parameter_values_are_written_as_ros_reads_them(value, text):
+    assert format_value(value) == text
+    assert yaml.safe_load(text) == ([""] if value == [] else value)
+
+
+def test_node_command_runs_the_module_with_the_params_file(tmp_path):
+    plant = describe(GraphOptions())[0]
+    command = node_command(plant, tmp_path / "p.yaml", "python")
+    assert command[:4] == ["python", "-m", "landing_gear_sim.nodes.plant", "--ros-args"]
+    assert command[4:6] == ["--params-file", str(tmp_path / "p.yaml")]
+    assert "clock:='lockstep'" in command
+
+
+def test_dds_stays_on_this_machine_unless_the_user_chose(monkeypatch):
+    env = ros_environment({})
+    assert env["ROS_AUTOMATIC_DISCOVERY_RANGE"] == "LOCALHOST"
+    assert 0 < int(env["ROS_DOMAIN_ID"]) <= 101
+    assert ros_environment({"ROS_DOMAIN_ID": "7"})["ROS_DOMAIN_ID"] == "7"
+
+
+def test_launch_arguments_become_graph_options(tmp_path):
+    options, params = options_from_arguments({"profile": "osc-high", "clock": "realtime",
+                                              "bag": str(tmp_path / "b")})
+    assert options.run.profile == "osc-high" and options.clock == "realtime"
+    assert params.name == "reference_rig.yaml"
+    controlled, _ = options_from_arguments({"controller": "slip"})
+    assert controlled.run.profile == "external" and controlled.controller == "slip"
+    with pytest.raises(LandingGearSimError, match="clock"):
+        options_from_arguments({"clock": "fast"})
+
+
+def test_launch_file_starts_exactly_the_described_nodes(monkeypatch, tmp_path):
+    """launch/launch_ros are not on PyPI: stand-ins record what the launch file builds."""
+    made: list[dict] = []
+
+    class Record:
+        def __init__(self, *args, **kwargs):
+            self.args, self.kwargs = args, kwargs
+
+    class Node(Record):
+        def __init__(self, **kwargs):
+            super().__init__(**kwargs)
+            made.append(kwargs)
+
+    class LaunchConfiguration:
+        def __init__(self, name):
+            self.name = name
+
+        def perform(self, context):
+            return context[self.name]
+
+    stubs = {"launch": {"LaunchDescription": lambda items: items},
+             "launch.actions": {"DeclareLaunchArgument": Record, "OpaqueFunction": Record},
+             "launch.substitutions": {"LaunchConfiguration": LaunchConfiguration},
+             "launch_ros": {}, "launch_ros.actions": {"Node": Node}}
+    for name, attributes in stubs.items():
+        monkeypatch.setitem(sys.modules, name, types.SimpleNamespace(**attributes))
+    items = runpy.run_path(str(ROOT / "launch" / "rig.launch.py"))["generate_launch_description"]()
+    declared = {item.args[0] for item in items[:-1]}
+    assert declared == set(LAUNCH_ARGUMENTS)
+    context = {name: default for name, (default, _) in LAUNCH_ARGUMENTS.items()}
+    context["bag"] = str(tmp_path / "bag")
+    items[-1].kwargs["function"](context)
+    options, _ = options_from_arguments(context)
+    described = describe(options)
+    assert [m["executable"] for m in made] == [n.name for n in described]
+    assert [m["parameters"][1] for m in made] == [n.parameters for n in described]
+    assert all(m["additional_env"]["ROS_AUTOMATIC_DISCOVERY_RANGE"] == "LOCALHOST" for m in made)
+
+
+def _float64(value: float) -> bytes:
+    message = TYPESTORE.types["std_msgs/msg/Float64"](data=value)
+    return bytes(TYPESTORE.serialize_cdr(message, "std_msgs/msg/Float64"))
+
+
+def _values(path: Path) -> list[float]:
+    with Reader(path) as reader:
+        return [TYPESTORE.deserialize_cdr(raw, c.msgtype).data
+                for c, _, raw in reader.messages()]
+
+
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_a_segmented_bag_reads_as_one_bag(tmp_path, storage):
+    writer = SegmentedBagWriter(tmp_path / "bag", {"/x": "std_msgs/msg/Float64"}, storage)
+    for k in range(30):
+        writer.write("/x", k * 1_000_000, _float64(k))
+        if k % 10 == 9:
+            writer.roll()
+    writer.close()
+    assert _values(tmp_path / "bag") == list(range(30))
+    assert len(list((tmp_path / "bag").glob("bag_*"))) == 3
+    assert not (tmp_path / "bag" / OPEN_SEGMENT).exists()
+
+
+def test_a_crashed_writer_leaves_a_bag_with_every_closed_segment(tmp_path):
+    writer = SegmentedBagWriter(tmp_path / "bag", {"/x": "std_msgs/msg/Float64"})
+    for k in range(25):
+        writer.write("/x", k * 1_000_000, _float64(k))
+        if k % 10 == 9:
+            writer.roll()
+    # no close(): as after SIGKILL, samples 20-24 are in the open segment only
+    assert _values(tmp_path / "bag") == list(range(20))
+
+
+def test_an_empty_recording_is_still_a_readable_bag(tmp_path):
+    SegmentedBagWriter(tmp_path / "bag", TOPIC_TYPES).close()
+    with Reader(tmp_path / "bag") as reader:
+        assert reader.message_count == 0
+    with pytest.raises(Exception, match="no messages"):
+        read_bag(tmp_path / "bag")

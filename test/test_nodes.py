@@ -1,0 +1,210 @@
+"""The ROS 2 graph for real: separate node processes on a private, machine-local DDS domain."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from landing_gear_sim.integrate import simulate
+from landing_gear_sim.launcher import ros_environment
+from landing_gear_sim.parameters import load_parameters
+from landing_gear_sim.runspec import RunSpec, build_scenario
+from msg_tools.bag_io import read_bag
+from msg_tools.csv_io import format_csv, write_csv
+
+pytest.importorskip("rclpy")
+
+# braking starts early and the run is short, so a graph run takes seconds
+SHORT = {"rig_test.brake_start_s": 0.3, "rig_test.max_duration_s": 1.5}
+FIELDS = ("current_a", "pressure_pa", "wheel_speed_rad_s", "flywheel_speed_rad_s",
+          "vertical_load_n", "longitudinal_force_n")
+
+
+def _sets(values: dict[str, float]) -> list[str]:
+    return [arg for key, value in values.items() for arg in ("--set", f"{key}={value}")]
+
+
+def _rig(*args: str, overrides: dict[str, float] = SHORT) -> list[str]:
+    return [sys.executable, "-m", "landing_gear_sim", "rig", *args, *_sets(overrides)]
+
+
+def _run(command: list[str], timeout: float = 120) -> subprocess.CompletedProcess:
+    return subprocess.run(command, capture_output=True, text=True, timeout=timeout,
+                          env=ros_environment())
+
+
+def _offline(overrides: dict[str, float], profile: str = "osc-low"):
+    params = load_parameters(overrides=overrides)
+    return simulate(params, build_scenario(RunSpec(profile=profile), params)).to_run()
+
+
+def _wait_for(predicate, timeout_s: float = 60.0) -> None:
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        assert time.monotonic() < deadline, "timed out"
+        time.sleep(0.05)
+
+
+def _pid_of(module: str, launcher: subprocess.Popen) -> int:
+    """The node process ``module`` that this launcher started (other tests run graphs too)."""
+    found = subprocess.run(["pgrep", "-P", str(launcher.pid), "-f", module],
+                           capture_output=True, text=True)
+    return int(found.stdout.split()[0])
+
+
+def test_lockstep_graph_equals_offline_and_gives_the_same_bag_every_time(tmp_path):
+    bags = [tmp_path / "first" / "bag", tmp_path / "second" / "bag"]
+    for bag in bags:
+        done = _run(_rig("--profile", "osc-low", "--bag", str(bag)))
+        assert done.returncode == 0, done.stderr[-3000:]
+    files = [sorted(p.relative_to(bag) for p in bag.iterdir()) for bag in bags]
+    assert files[0] == files[1]
+    for name in files[0]:
+        assert (bags[0] / name).read_bytes() == (bags[1] / name).read_bytes(), name
+    graph, offline = read_bag(bags[0]), _offline(SHORT)
+    assert len(graph) == len(offline) == 1500
+    for field in FIELDS:  # every recorded topic reads back, equal to round-off
+        np.testing.assert_allclose(getattr(graph, field), getattr(offline, field),
+                                   rtol=1e-9, atol=1e-6, err_msg=field)
+    assert offline.pressure_pa.max() > 30e5  # the run brakes: the comparison means something
+
+
+def test_sigint_to_the_graph_leaves_a_bag_with_the_run_up_to_the_stop(tmp_path):
+    bag = tmp_path / "bag"
+    long_run = {**SHORT, "rig_test.max_duration_s": 30.0}
+    launcher = subprocess.Popen(_rig("--profile", "osc-low", "--bag", str(bag),
+                                     overrides=long_run), env=ros_environment(),
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _wait_for(lambda: (bag / "metadata.yaml").exists())
+    launcher.send_signal(signal.SIGINT)
+    _, stderr = launcher.communicate(timeout=60)
+    assert launcher.returncode == 130, stderr[-2000:]
+    stopped = read_bag(bag)
+    offline = _offline(long_run)
+    assert 100 < len(stopped) < len(offline)
+    np.testing.assert_allclose(stopped.wheel_speed_rad_s,
+                               offline.wheel_speed_rad_s[:len(stopped)], rtol=1e-9, atol=1e-6)
+
+
+def test_a_killed_recorder_leaves_a_readable_bag_and_the_run_goes_on(tmp_path):
+    bag = tmp_path / "bag"
+    run = {**SHORT, "rig_test.max_duration_s": 6.0}
+    launcher = subprocess.Popen(_rig("--profile", "osc-low", "--bag", str(bag), overrides=run),
+                                env=ros_environment(), stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
+    _wait_for(lambda: (bag / "metadata.yaml").exists() and len(list(bag.glob("bag_*"))) >= 2)
+    os.kill(_pid_of("nodes.recorder", launcher), signal.SIGKILL)
+    _, stderr = launcher.communicate(timeout=120)
+    assert launcher.returncode == 0, stderr[-2000:]
+    assert "recorder died" in stderr
+    survived = read_bag(bag)  # readable as it is, no repair step
+    assert survived.time_s[-1] >= 0.5
+    np.testing.assert_allclose(survived.pressure_pa, _offline(run).pressure_pa[:len(survived)],
+                               rtol=1e-9, atol=1e-6)
+
+
+def test_a_killed_actuator_neither_hangs_nor_crashes_the_plant(tmp_path):
+    bag = tmp_path / "bag"
+    run = {**SHORT, "rig_test.max_duration_s": 4.0}
+    launcher = subprocess.Popen(_rig("--profile", "osc-low", "--bag", str(bag), "--timeout",
+                                     "0.5", overrides=run),
+                                env=ros_environment(), stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
+    _wait_for(lambda: (bag / "metadata.yaml").exists())
+    os.kill(_pid_of("nodes.actuator", launcher), signal.SIGKILL)
+    _, stderr = launcher.communicate(timeout=120)
+    assert launcher.returncode == 0, stderr[-2000:]
+    assert "no input from actuator" in stderr
+    recorded = read_bag(bag)
+    assert len(recorded) == 4000  # the plant ran the whole run
+    assert recorded.pressure_pa[-1] == 0.0  # the brake went to the safe pressure
+
+
+def test_realtime_graph_follows_the_wall_clock(tmp_path):
+    bag = tmp_path / "bag"
+    started = time.monotonic()
+    done = _run(_rig("--profile", "osc-low", "--clock", "realtime", "--bag", str(bag)))
+    assert done.returncode == 0, done.stderr[-3000:]
+    recorded = read_bag(bag)
+    assert len(recorded) == 1500
+    assert time.monotonic() - started > 1.5
+    rtf = float(re.search(r"real-time factor ([0-9.]+)", done.stderr).group(1))
+    assert rtf <= 1.05  # paced by the wall clock: never faster (slower only if starved)
+
+
+def test_replay_publishes_a_run_that_the_recorder_writes_back(tmp_path, reference):
+    measured = _offline(SHORT)
+    write_csv(measured, tmp_path / "run.csv")
+    bag = tmp_path / "bag"
+    env = ros_environment()
+    node = [sys.executable, "-m"]
+    recorder = subprocess.Popen([*node, "landing_gear_sim.nodes.recorder", "--ros-args", "-p",
+                                 f"bag:={bag}"], env=env, stderr=subprocess.PIPE, text=True)
+    replay = _run([*node, "landing_gear_sim.nodes.replay", "--ros-args", "-p",
+                   f"file:={tmp_path / 'run.csv'}", "-p", "speed:=5.0",
+                   "-p", "wait_for_subscribers:=1"])
+    assert replay.returncode == 0, replay.stderr[-2000:]
+    recorder.wait(timeout=60)
+    replayed = read_bag(bag)
+    assert len(replayed) == len(measured)
+    for field in FIELDS:
+        np.testing.assert_allclose(getattr(replayed, field), getattr(measured, field),
+                                   rtol=1e-9, atol=1e-4, err_msg=field)
+
+
+def _bad_files(folder: Path) -> dict[str, tuple[Path, str]]:
+    good = format_csv(_offline({"rig_test.max_duration_s": 0.05}))
+    header, *rows = good.splitlines()
+    cases = {
+        "missing": ("", "no such file"),
+        "empty": ("", "the file is empty"),
+        "header_only": (header + "\n", "expected >= 2 rows"),
+        "no_column": (good.replace("brake_pressure_bar", "pressure"), "missing column"),
+        "nan": ("\n".join([header, rows[0].replace(rows[0].split(",")[2], "nan", 1), *rows[1:]]),
+                "NaN"),
+        "time_back": ("\n".join([header, rows[1], rows[0], *rows[2:]]), "not strictly increasing"),
+        "garbage": ("\x00\x01binary", "missing column"),
+    }
+    files = {}
+    for name, (text, fragment) in cases.items():
+        path = folder / f"{name}.csv"
+        if name != "missing":
+            path.write_text(text)
+        files[name] = (path, fragment)
+    return files
+
+
+def test_replay_of_a_bad_file_is_one_error_line_and_exit_2(tmp_path):
+    for name, (path, fragment) in _bad_files(tmp_path).items():
+        done = _run([sys.executable, "-m", "landing_gear_sim.nodes.replay", "--ros-args", "-p",
+                     f"file:={path}"], timeout=60)
+        lines = done.stderr.strip().splitlines()
+        assert done.returncode == 2, (name, done.stderr)
+        assert len(lines) == 1 and str(path) in lines[0] and fragment in lines[0], (name, lines)
+
+
+def test_rig_replay_reruns_a_logged_test_in_the_graph_as_offline(tmp_path):
+    """The measured current of a rig log drives the graph; the bag equals the offline re-run."""
+    measured = _offline(SHORT)
+    write_csv(measured, tmp_path / "rig_log.csv")
+    done = _run(_rig("--replay", str(tmp_path / "rig_log.csv"), "--bag", str(tmp_path / "bag")))
+    assert done.returncode == 0, done.stderr[-3000:]
+    params = load_parameters(overrides=SHORT)
+    rerun = simulate(params, build_scenario(RunSpec(profile="file",
+                                                    file=str(tmp_path / "rig_log.csv")),
+                                            params)).to_run()
+    graph = read_bag(tmp_path / "bag")
+    assert len(graph) == len(rerun)
+    for field in FIELDS:
+        np.testing.assert_allclose(getattr(graph, field), getattr(rerun, field), rtol=1e-9,
+                                   atol=1e-6, err_msg=field)
+    # and the re-run reproduces the log it came from (same model: to the CSV's digits)
+    np.testing.assert_allclose(graph.pressure_pa, measured.pressure_pa, atol=50.0)

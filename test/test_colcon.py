@@ -12,7 +12,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE_FILES = ("package.xml", "setup.py", "setup.cfg", "README.md", "resource", "config",
-                 "landing_gear_sim", "antiskid", "msg_tools")
+                 "landing_gear_sim", "antiskid", "msg_tools", "launch")
 COLCON = Path(sys.executable).parent / "colcon"
 
 
@@ -42,9 +42,11 @@ def workspace(tmp_path_factory) -> Path:
 def test_build_installs_the_ament_index_marker_and_executables(workspace):
     prefix = workspace / "install" / "landing_gear_sim"
     assert (prefix / "share/ament_index/resource_index/packages/landing_gear_sim").is_file()
-    for executable in ("landing-gear-sim", "simulate", "bode"):
-        assert os.access(prefix / "lib/landing_gear_sim" / executable, os.X_OK)
+    for executable in ("landing-gear-sim", "simulate", "bode", "plant", "actuator",
+                       "loading_device", "profile", "recorder", "replay"):
+        assert os.access(prefix / "lib/landing_gear_sim" / executable, os.X_OK), executable
     assert (prefix / "share/landing_gear_sim/config/reference_rig.yaml").is_file()
+    assert (prefix / "share/landing_gear_sim/launch/rig.launch.py").is_file()
 
 
 def test_ros2_run_resolution_finds_and_runs_the_executable(workspace):
@@ -65,3 +67,19 @@ echo "prefix=$prefix"
     # the installed copy reads the config installed with it
     assert f"from: {prefix}/share/landing_gear_sim/config/reference_rig.yaml" in result.stdout
     assert "friction.theta1" in result.stdout
+
+
+def test_an_installed_node_runs_and_refuses_a_bad_parameter(workspace):
+    """`ros2 run landing_gear_sim plant` starts rclpy, reads its parameters, says what is wrong."""
+    script = """
+set -e
+source install/setup.bash
+install/landing_gear_sim/lib/landing_gear_sim/plant --ros-args -p run.profile:=nope
+"""
+    env = {**os.environ, "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
+    result = subprocess.run(["bash", "-c", script], cwd=workspace, capture_output=True,
+                            text=True, check=False, env=env, timeout=120)
+    assert result.returncode == 2, result.stderr
+    assert result.stderr.strip().splitlines() == [
+        "plant: error: unknown profile 'nope'; choose from constant, osc-low, osc-high, ramp, "
+        "steps, sweep, steps-sweep, file, external"]

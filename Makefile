@@ -46,6 +46,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/run.py
 	$(BIN)/python bench/identify.py
 	$(BIN)/python bench/graph.py
+	$(BIN)/python bench/controllers.py
 
 clean:
 	rm -rf $(VENV) out build install log .pytest_cache

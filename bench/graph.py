@@ -64,6 +64,9 @@ def realtime_periods(duration_s: float) -> tuple[float, float]:
         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     while graph.poll() is None:
         rclpy.spin_once(node, timeout_sec=0.1)
+    drain_until = time.monotonic() + 2.0  # messages still queued when the graph left
+    while time.monotonic() < drain_until:
+        rclpy.spin_once(node, timeout_sec=0.05)
     node.destroy_node()
     rclpy.shutdown()
     periods = np.diff(np.asarray(arrivals))

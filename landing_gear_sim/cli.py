@@ -24,6 +24,7 @@ from .parameters import ELEMENTS, SPECS, RigParameters, load_parameters, parse_a
 from .runspec import PROFILES, RunSpec, build_scenario
 
 if TYPE_CHECKING:
+    from antiskid.metrics import BrakingMetrics
     from msg_tools.run import Run
 
     from .diagnose import Diagnosis
@@ -134,6 +135,8 @@ def cmd_rig(args: argparse.Namespace) -> int:
     if args.replay is not None:
         spec = RunSpec(profile="file", file=str(args.replay), contact=spec.contact,
                        rate_hz=spec.rate_hz)
+    if args.controller is not None:
+        spec = RunSpec(profile="external", rate_hz=spec.rate_hz)
     scenario = build_scenario(spec, params)  # fail here, not in five processes
     bag = None if args.no_bag else args.bag or Path("out") / "rig" / (
         f"{scenario.name}_{time.strftime('%Y%m%d-%H%M%S')}")
@@ -142,7 +145,7 @@ def cmd_rig(args: argparse.Namespace) -> int:
     options = GraphOptions(run=spec, clock=args.clock, bag=bag, storage=args.storage,
                            sensor_noise=args.noise, timeout_s=args.timeout,
                            safe_pressure_pa=args.safe_pressure_bar * 1e5,
-                           replay=args.replay is not None)
+                           replay=args.replay is not None, controller=args.controller)
     _progress(f"{scenario.name}: {args.clock} graph, up to {scenario.duration_s:.1f} s at "
               f"{scenario.rate_hz:g} Hz")
     started = time.perf_counter()
@@ -168,6 +171,83 @@ def _bag_summary(bag: Path) -> str:
     return (f"bag: {bag} ({len(run)} samples, {run.time_s[-1]:.3f} s, max pressure "
             f"{run.pressure_pa.max() / 1e5:.2f} bar, flywheel {run.flywheel_speed_rad_s[0]:.1f}"
             f" -> {run.flywheel_speed_rad_s[-1]:.1f} rad/s)")
+
+
+def cmd_metrics(args: argparse.Namespace) -> int:
+    from antiskid.metrics import braking_metrics
+    from msg_tools.io import read_run
+
+    rig = _params(args)
+    run = read_run(args.run, _mapping(args))
+    metrics = braking_metrics(run, rig)
+    print(_metrics_table({run.name: metrics}))
+    _write_braking_outputs(args, run, rig, metrics)
+    return 0
+
+
+def cmd_antiskid(args: argparse.Namespace) -> int:
+    from antiskid.closed_loop import (
+        closed_loop,
+        constant_pressure_baseline,
+        make_controller,
+        with_surface,
+    )
+    from antiskid.metrics import braking_metrics
+    from msg_tools.csv_io import write_csv
+
+    rig = with_surface(_params(args), args.surface)
+    settings = dict(parse_assignment(text) for text in args.setting)
+    step_s = 1.0 / (args.rate or rig.number("simulation.output_rate_hz"))
+    controller = make_controller(args.controller, rig, step_s, settings)
+    _progress(f"{args.controller} controller on the {args.surface} surface, closed loop")
+    run = closed_loop(rig, controller, args.rate or 0.0).to_run()
+    run = type(run)(**{**run.__dict__, "name": f"{args.controller}_{args.surface}"})
+    metrics = braking_metrics(run, rig)
+    _progress("constant-pressure baseline just below the skid pressure (bisection)")
+    pressure, baseline = constant_pressure_baseline(rig)
+    rows = {run.name: metrics,
+            f"constant {pressure / 1e5:.1f} bar": braking_metrics(baseline.to_run(), rig)}
+    print(_metrics_table(rows))
+    if metrics.cycling_near_gear_walk:
+        print(f"WARNING: pressure cycles at {metrics.cycling_frequency_hz:.1f} Hz, near the "
+              f"gear-walk resonance ({metrics.gear_walk_frequency_hz:.1f} Hz)")
+    output = args.output or Path("out") / f"{run.name}.csv"
+    output.parent.mkdir(parents=True, exist_ok=True)
+    write_csv(run, output)
+    print(f"  csv:  {output}")
+    _write_braking_outputs(args, run, rig, metrics, output.with_suffix(".png"))
+    return 0
+
+
+def _metrics_table(rows: dict[str, BrakingMetrics]) -> str:
+    header = (f"{'run':24s} {'eff':>5s} {'mu':>5s} {'stop m':>7s} {'stop s':>6s} "
+              f"{'decel':>6s} {'slip rms':>8s} {'max':>5s} {'locks':>5s} {'cycling Hz':>10s}")
+    lines = [header]
+    for name, m in rows.items():
+        lines.append(f"{name:24s} {m.braking_efficiency:5.3f} {m.mean_friction:5.3f} "
+                     f"{m.stopping_distance_m:7.1f} {m.stopping_time_s:6.2f} "
+                     f"{m.mean_deceleration_m_s2:6.2f} {m.slip_rms:8.3f} {m.slip_max:5.3f} "
+                     f"{m.lock_events:5d} {m.cycling_frequency_hz:10.2f}")
+    return "\n".join(lines)
+
+
+def _write_braking_outputs(args: argparse.Namespace, run: Run, rig: RigParameters,
+                           metrics: BrakingMetrics, default_plot: Path | None = None) -> None:
+    import json
+
+    from antiskid.metrics import rolling_radius, slip_of
+    from antiskid.plotting import plot_braking
+
+    if args.json:
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text(json.dumps(metrics.to_dict(), indent=1))
+        print(f"  json: {args.json}")
+    plot = args.plot or default_plot
+    if plot is not None:
+        wheel = run.wheel_speed_rad_s * rolling_radius(rig, np.maximum(run.vertical_load_n, 0))
+        flywheel = run.flywheel_speed_rad_s * rig.number("flywheel.radius_m")
+        path = plot_braking(run, slip_of(run, rig), wheel, flywheel, metrics, plot)
+        print(f"  plot: {path}")
 
 
 def cmd_bode(args: argparse.Namespace) -> int:
@@ -423,6 +503,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_run_arguments(rig)
     rig.add_argument("--replay", type=Path, metavar="RUN",
                      help="re-run a recorded rig test: its current drives the simulated graph")
+    rig.add_argument("--controller", choices=["threshold", "slip"],
+                     help="anti-skid controller in closed loop instead of a profile")
     rig.add_argument("--clock", choices=["lockstep", "realtime"], default="lockstep",
                      help="lockstep: sim time, deterministic (default); realtime: wall clock")
     rig.add_argument("--bag", type=Path, help="bag folder (default out/rig/<run>_<time>)")
@@ -434,6 +516,28 @@ def build_parser() -> argparse.ArgumentParser:
     rig.add_argument("--safe-pressure-bar", type=float, default=0.0,
                      help="brake pressure applied once the actuator is lost (default 0)")
     rig.set_defaults(func=cmd_rig)
+
+    met = sub.add_parser("metrics", help="braking metrics of a run (efficiency, locks, ...)")
+    met.add_argument("run", type=Path, help="CSV or bag of a braking run")
+    _add_params_arguments(met)
+    met.add_argument("--mapping", type=Path, help="column-mapping file for a CSV")
+    met.add_argument("--plot", type=Path, help="PNG like the paper's Fig. 1")
+    met.add_argument("--json", type=Path, help="write the metrics as JSON")
+    met.set_defaults(func=cmd_metrics)
+
+    anti = sub.add_parser("antiskid", help="an anti-skid controller against the rig model, "
+                          "offline; metrics against a constant-pressure stop")
+    anti.add_argument("--controller", choices=["threshold", "slip"], default="threshold")
+    anti.add_argument("--surface", choices=["dry", "wet", "snow"], default="dry",
+                      help="runway friction curve (dry: the rig's own)")
+    _add_params_arguments(anti)
+    anti.add_argument("--setting", action="append", default=[], metavar="KEY=VALUE",
+                      help="controller setting, e.g. --setting slip_setpoint=0.1")
+    anti.add_argument("--rate", type=float, help="controller rate [Hz] (default from config)")
+    anti.add_argument("-o", "--output", type=Path, help="CSV of the run (default out/)")
+    anti.add_argument("--plot", type=Path, help="PNG (default next to the CSV)")
+    anti.add_argument("--json", type=Path, help="write the metrics as JSON")
+    anti.set_defaults(func=cmd_antiskid)
 
     bode = sub.add_parser("bode", help="frequency responses G_lambda, G_eta (paper Fig. 7)")
     _add_params_arguments(bode)

@@ -38,6 +38,7 @@ TOPIC_CLOCK = "/clock"
 SENSOR_TOPICS = (TOPIC_WHEEL, TOPIC_FLYWHEEL, TOPIC_PRESSURE, TOPIC_WRENCH)
 RECORDED_TOPICS = (TOPIC_CURRENT, *SENSOR_TOPICS)
 
+CONTROLLER_NODE = "antiskid_controller"
 CLOCKS = ("lockstep", "realtime")
 STORAGES = ("mcap", "sqlite3")
 
@@ -56,7 +57,7 @@ class NodeSpec:
     @property
     def module(self) -> str:
         """Python module whose ``main`` runs this node."""
-        return f"{PACKAGE}.nodes.{self.name}"
+        return "antiskid.node" if self.name == CONTROLLER_NODE else f"{PACKAGE}.nodes.{self.name}"
 
 
 @dataclass(frozen=True)
@@ -75,6 +76,8 @@ class GraphOptions:
         replay: the run's current comes from the ``replay`` node (``run.file``), not
             the profile node.
     """
+    # a controller graph is a rig test braking from rig_test.brake_start_s: run.profile
+    # is "external" (see options_from_arguments and the rig command)
 
     run: RunSpec = field(default_factory=RunSpec)
     clock: str = "lockstep"
@@ -152,7 +155,7 @@ def describe(options: GraphOptions) -> list[NodeSpec]:
         NodeSpec("loading_device", {**run, **clock}, (TOPIC_LOAD,), (TOPIC_FLYWHEEL,)),
     ]
     if options.controller:
-        nodes.append(NodeSpec("antiskid_controller", {**clock, "type": options.controller},
+        nodes.append(NodeSpec(CONTROLLER_NODE, {**run, **clock, "type": options.controller},
                               (TOPIC_CURRENT,), (TOPIC_WHEEL, TOPIC_FLYWHEEL)))
     elif options.replay:
         nodes.append(NodeSpec("replay", {**run, **clock, "topics": "current",

@@ -208,3 +208,19 @@ def test_rig_replay_reruns_a_logged_test_in_the_graph_as_offline(tmp_path):
                                    atol=1e-6, err_msg=field)
     # and the re-run reproduces the log it came from (same model: to the CSV's digits)
     np.testing.assert_allclose(graph.pressure_pa, measured.pressure_pa, atol=50.0)
+
+
+@pytest.mark.parametrize("kind", ["threshold", "slip"])
+def test_controller_node_in_lockstep_equals_the_offline_closed_loop(tmp_path, kind):
+    from antiskid.closed_loop import closed_loop, make_controller
+
+    done = _run(_rig("--controller", kind, "--bag", str(tmp_path / "bag")))
+    assert done.returncode == 0, done.stderr[-3000:]
+    rig = load_parameters(overrides=SHORT)
+    offline = closed_loop(rig, make_controller(kind, rig, 1e-3)).to_run()
+    graph = read_bag(tmp_path / "bag")
+    assert len(graph) == len(offline) == 1500
+    assert offline.current_a.max() > 0.3  # the controller did brake in this short run
+    for field in FIELDS:
+        np.testing.assert_allclose(getattr(graph, field), getattr(offline, field), rtol=1e-9,
+                                   atol=1e-6, err_msg=field)

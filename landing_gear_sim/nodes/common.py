@@ -228,10 +228,10 @@ class GraphNode(Node):
 def run_node(factory: Callable[[], Node], args: list[str] | None = None) -> int:
     """init, build the node, spin until the run ends or a signal; one error line on failure."""
     rclpy.init(args=args)
+    executor = rclpy.executors.SingleThreadedExecutor()
     node = None
     try:
         node = factory()
-        executor = rclpy.executors.SingleThreadedExecutor()
         executor.add_node(node)
         executor.spin()
     except (RunFinishedError, KeyboardInterrupt, ExternalShutdownException):
@@ -242,6 +242,7 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None) -> int:
     finally:
         if isinstance(node, GraphNode):
             node.close()
+        executor.shutdown()  # before the context goes: its __del__ would use it
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()

@@ -1,0 +1,121 @@
+"""What a braking run achieved, from any run (simulated or measured).
+
+The peak available friction comes from the rig's friction curve (the model's, calibrated
+for a measured run); everything else from the run's signals.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import scipy.integrate
+import scipy.signal
+
+from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.parameters import RigParameters
+from msg_tools.run import Run
+
+LOCK_SLIP = 0.95  # a wheel at 95 % slip or more is locked
+LOCK_MIN_SPEED_M_S = 5.0  # locks below this speed are the stop itself, not a skid
+MIN_LOAD_N = 1000.0  # below this the wheel is not on the flywheel: no friction to speak of
+CYCLE_PROMINENCE_PA = 2e5  # a pressure cycle is a peak standing 2 bar above its valleys
+GEAR_WALK_BAND = 0.3  # cycling within ±30 % of the gear-walk frequency is flagged
+
+
+@dataclass(frozen=True)
+class BrakingMetrics:
+    """Stopping performance of one run, SI."""
+
+    stopping_distance_m: float
+    stopping_time_s: float
+    mean_deceleration_m_s2: float
+    braking_efficiency: float
+    mean_friction: float
+    peak_friction: float
+    slip_rms: float
+    slip_max: float
+    lock_events: int
+    lock_duration_s: float
+    cycling_frequency_hz: float
+    gear_walk_frequency_hz: float
+    cycling_near_gear_walk: bool
+
+    def to_dict(self) -> dict[str, float | int | bool]:
+        return asdict(self)
+
+
+def peak_friction(rig: RigParameters) -> tuple[float, float]:
+    """Peak μ of the rig's friction curve and the slip where it occurs."""
+    t1, t2, t3 = (rig.number(f"friction.theta{i}") for i in (1, 2, 3))
+    slip = np.linspace(0.0, 1.0, 20001)
+    mu = t1 * (1.0 - np.exp(-t2 * slip)) - t3 * slip
+    best = int(np.argmax(mu))
+    return float(mu[best]), float(slip[best])
+
+
+def gear_walk_frequency_hz(rig: RigParameters) -> float:
+    inertia = rig.number("gear_walk.inertia_kg_m2")
+    return math.sqrt(rig.number("gear_walk.stiffness_n_m_per_rad") / inertia) / (2 * math.pi)
+
+
+def rolling_radius(rig: RigParameters, load_n: np.ndarray) -> np.ndarray:
+    radius = np.full_like(load_n, rig.number("wheel.unloaded_radius_m"))
+    if rig.has("load_dependent_radius"):
+        radius -= (rig.number("radius.a_m_per_n2") * load_n ** 2
+                   + rig.number("radius.b_m_per_n") * load_n + rig.number("radius.c_m"))
+    return radius
+
+
+def braking_window(run: Run) -> slice:
+    """From the first commanded current to the end of the run."""
+    active = np.flatnonzero(run.current_a > 1e-3)
+    if active.size == 0 or float(np.max(run.vertical_load_n)) < MIN_LOAD_N:
+        raise LandingGearSimError(f"{run.name}: not a braking run (no current, or the wheel "
+                                  "never touches the flywheel)")
+    return slice(int(active[0]), len(run))
+
+
+def slip_of(run: Run, rig: RigParameters) -> np.ndarray:
+    speed = run.flywheel_speed_rad_s * rig.number("flywheel.radius_m")
+    wheel = run.wheel_speed_rad_s * rolling_radius(rig, np.maximum(run.vertical_load_n, 0.0))
+    return np.where(speed > 0.5, (speed - wheel) / np.maximum(speed, 0.5), 0.0)
+
+
+def braking_metrics(run: Run, rig: RigParameters) -> BrakingMetrics:
+    """Metrics of the braking phase of ``run`` on the rig ``rig``."""
+    window = braking_window(run)
+    t = run.time_s[window]
+    speed = run.flywheel_speed_rad_s[window] * rig.number("flywheel.radius_m")
+    load = run.vertical_load_n[window]
+    slip = slip_of(run, rig)[window]
+    loaded = load > MIN_LOAD_N
+    friction = run.longitudinal_force_n[window][loaded] / load[loaded]
+    peak, _ = peak_friction(rig)
+    moving = speed > LOCK_MIN_SPEED_M_S
+    locked = (slip >= LOCK_SLIP) & moving
+    duration = float(t[-1] - t[0])
+    cycles = _cycling_frequency(run.pressure_pa[window], duration)
+    gear_walk = gear_walk_frequency_hz(rig)
+    return BrakingMetrics(
+        stopping_distance_m=float(scipy.integrate.trapezoid(speed, t)),
+        stopping_time_s=duration,
+        mean_deceleration_m_s2=float(speed[0] - speed[-1]) / max(duration, 1e-9),
+        braking_efficiency=float(np.mean(friction)) / peak,
+        mean_friction=float(np.mean(friction)),
+        peak_friction=peak,
+        slip_rms=float(np.sqrt(np.mean(slip[moving] ** 2))) if moving.any() else 0.0,
+        slip_max=float(np.max(slip[moving])) if moving.any() else 0.0,
+        lock_events=int(np.count_nonzero(np.diff(locked.astype(int)) == 1) + int(locked[0])),
+        lock_duration_s=float(np.count_nonzero(locked)) / run.rate_hz,
+        cycling_frequency_hz=cycles,
+        gear_walk_frequency_hz=gear_walk,
+        cycling_near_gear_walk=cycles > 0 and abs(cycles - gear_walk) <= GEAR_WALK_BAND * gear_walk,
+    )
+
+
+def _cycling_frequency(pressure_pa: np.ndarray, duration_s: float) -> float:
+    """Release cycles per second: pressure peaks standing out by CYCLE_PROMINENCE_PA."""
+    peaks, _ = scipy.signal.find_peaks(pressure_pa, prominence=CYCLE_PROMINENCE_PA)
+    return len(peaks) / duration_s if duration_s > 0 and len(peaks) >= 2 else 0.0

@@ -1,0 +1,78 @@
+"""``antiskid_controller`` node: a controller of :mod:`antiskid` in the rig graph.
+
+``ros2 run landing_gear_sim antiskid_controller --ros-args -p type:=slip``. It answers
+each plant sample (wheel and flywheel speeds with the same stamp) with the current for
+that step on ``/rig/brake/current_ref``; the step function is the one the offline closed
+loop calls (:func:`antiskid.closed_loop.make_controller`). Settings: ``threshold.*`` and
+``slip.*`` parameters (see :class:`ThresholdParams`, :class:`SlipParams`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import fields
+
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64
+
+from landing_gear_sim.blocks import step_time
+from landing_gear_sim.nodes.common import (
+    GraphNode,
+    Handshake,
+    announce_ready,
+    declare,
+    lockstep,
+    main_for,
+    rig_parameters,
+    run_spec,
+    step_of,
+)
+from landing_gear_sim.runspec import build_scenario
+from msg_tools.contract import TOPIC_CURRENT, TOPIC_FLYWHEEL, TOPIC_WHEEL
+
+from .closed_loop import CONTROLLERS, make_controller, settings_type
+from .errors import ControllerError
+
+
+class AntiskidControllerNode(GraphNode):
+    def __init__(self) -> None:
+        super().__init__("antiskid_controller")
+        rig = rig_parameters(self)
+        lockstep(self)
+        scenario = build_scenario(run_spec(self), rig)
+        kind = str(declare(self, "type", "threshold", "threshold | slip"))
+        if kind not in CONTROLLERS:
+            raise ControllerError(f"type must be one of {', '.join(CONTROLLERS)}, got {kind!r}")
+        settings = {f.name: declare(self, f"{kind}.{f.name}", f.default, f"{kind} setting")
+                    for f in fields(settings_type(kind))}
+        self._step = make_controller(kind, rig, scenario.step_s, settings)
+        self._rate_hz, self._step_s = scenario.rate_hz, scenario.step_s
+        self._speeds: dict[int, dict[str, float]] = {}
+        self._message = Float64()
+        self._out = self.publisher(Float64, TOPIC_CURRENT)
+        inputs = [self.subscription(JointState, topic, self._on_speed(topic))
+                  for topic in (TOPIC_WHEEL, TOPIC_FLYWHEEL)]
+        Handshake(self, {TOPIC_CURRENT: self._out}, inputs, announce_ready(self))
+        self.get_logger().info(f"{kind} controller: {settings}")
+
+    def _on_speed(self, topic: str) -> Callable[[JointState], None]:
+        def take(message: JointState) -> None:
+            step = step_of(message.header.stamp, self._rate_hz)
+            speeds = self._speeds.setdefault(step, {})
+            speeds[topic] = message.velocity[0]
+            if len(speeds) == 2:
+                del self._speeds[step]
+                self._answer(step, speeds[TOPIC_WHEEL], speeds[TOPIC_FLYWHEEL])
+
+        return take
+
+    def _answer(self, step: int, wheel_rad_s: float, flywheel_rad_s: float) -> None:
+        self._message.data = self._step(step_time(step, self._step_s), wheel_rad_s,
+                                        flywheel_rad_s)
+        self._out.publish(self._message)
+
+
+main = main_for(AntiskidControllerNode)
+
+if __name__ == "__main__":
+    main()

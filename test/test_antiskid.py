@@ -48,7 +48,7 @@ def test_threshold_logic_cycles_on_the_slip_without_locking(reference, surface):
     assert result.stop_reason == "stop speed reached"
     assert metrics.lock_events == 0
     assert metrics.cycling_frequency_hz > 1.0  # the limit cycle of the paper's Fig. 1
-    assert metrics.braking_efficiency > 0.6  # reported against 0.80 by bench/controllers.py
+    assert metrics.braking_efficiency >= 0.80  # 14 CFR 25.109 default credit
 
 
 def test_both_controllers_beat_nothing_but_release_before_the_skid(reference):

@@ -41,6 +41,27 @@ def _run(command: list[str], timeout: float = 120) -> subprocess.CompletedProces
                           env=ros_environment())
 
 
+@pytest.fixture
+def start():
+    """Start a launcher in the background; whatever a failed test leaves running is stopped."""
+    started: list[subprocess.Popen] = []
+
+    def launch(command: list[str]) -> subprocess.Popen:
+        process = subprocess.Popen(command, env=ros_environment(), stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE, text=True)
+        started.append(process)
+        return process
+
+    yield launch
+    for process in started:
+        if process.poll() is None:
+            process.send_signal(signal.SIGINT)  # the launcher stops its nodes
+            try:
+                process.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                process.kill()
+
+
 def _offline(overrides: dict[str, float], profile: str = "osc-low"):
     params = load_parameters(overrides=overrides)
     return simulate(params, build_scenario(RunSpec(profile=profile), params)).to_run()
@@ -77,12 +98,10 @@ def test_lockstep_graph_equals_offline_and_gives_the_same_bag_every_time(tmp_pat
     assert offline.pressure_pa.max() > 30e5  # the run brakes: the comparison means something
 
 
-def test_sigint_to_the_graph_leaves_a_bag_with_the_run_up_to_the_stop(tmp_path):
+def test_sigint_to_the_graph_leaves_a_bag_with_the_run_up_to_the_stop(tmp_path, start):
     bag = tmp_path / "bag"
     long_run = {**SHORT, "rig_test.max_duration_s": 30.0}
-    launcher = subprocess.Popen(_rig("--profile", "osc-low", "--bag", str(bag),
-                                     overrides=long_run), env=ros_environment(),
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    launcher = start(_rig("--profile", "osc-low", "--bag", str(bag), overrides=long_run))
     _wait_for(lambda: (bag / "metadata.yaml").exists())
     launcher.send_signal(signal.SIGINT)
     _, stderr = launcher.communicate(timeout=60)
@@ -94,12 +113,10 @@ def test_sigint_to_the_graph_leaves_a_bag_with_the_run_up_to_the_stop(tmp_path):
                                offline.wheel_speed_rad_s[:len(stopped)], rtol=1e-9, atol=1e-6)
 
 
-def test_a_killed_recorder_leaves_a_readable_bag_and_the_run_goes_on(tmp_path):
+def test_a_killed_recorder_leaves_a_readable_bag_and_the_run_goes_on(tmp_path, start):
     bag = tmp_path / "bag"
     run = {**SHORT, "rig_test.max_duration_s": 6.0}
-    launcher = subprocess.Popen(_rig("--profile", "osc-low", "--bag", str(bag), overrides=run),
-                                env=ros_environment(), stdout=subprocess.PIPE,
-                                stderr=subprocess.PIPE, text=True)
+    launcher = start(_rig("--profile", "osc-low", "--bag", str(bag), overrides=run))
     _wait_for(lambda: (bag / "metadata.yaml").exists() and len(list(bag.glob("bag_*"))) >= 2)
     os.kill(_pid_of("nodes.recorder", launcher), signal.SIGKILL)
     _, stderr = launcher.communicate(timeout=120)
@@ -111,13 +128,11 @@ def test_a_killed_recorder_leaves_a_readable_bag_and_the_run_goes_on(tmp_path):
                                rtol=1e-9, atol=1e-6)
 
 
-def test_a_killed_actuator_neither_hangs_nor_crashes_the_plant(tmp_path):
+def test_a_killed_actuator_neither_hangs_nor_crashes_the_plant(tmp_path, start):
     bag = tmp_path / "bag"
     run = {**SHORT, "rig_test.max_duration_s": 4.0}
-    launcher = subprocess.Popen(_rig("--profile", "osc-low", "--bag", str(bag), "--timeout",
-                                     "0.5", overrides=run),
-                                env=ros_environment(), stdout=subprocess.PIPE,
-                                stderr=subprocess.PIPE, text=True)
+    launcher = start(_rig("--profile", "osc-low", "--bag", str(bag), "--timeout", "0.5",
+                          overrides=run))
     _wait_for(lambda: (bag / "metadata.yaml").exists())
     os.kill(_pid_of("nodes.actuator", launcher), signal.SIGKILL)
     _, stderr = launcher.communicate(timeout=120)
@@ -148,11 +163,15 @@ def test_replay_publishes_a_run_that_the_recorder_writes_back(tmp_path, referenc
     node = [sys.executable, "-m"]
     recorder = subprocess.Popen([*node, "landing_gear_sim.nodes.recorder", "--ros-args", "-p",
                                  f"bag:={bag}"], env=env, stderr=subprocess.PIPE, text=True)
-    replay = _run([*node, "landing_gear_sim.nodes.replay", "--ros-args", "-p",
-                   f"file:={tmp_path / 'run.csv'}", "-p", "speed:=5.0",
-                   "-p", "wait_for_subscribers:=1"])
-    assert replay.returncode == 0, replay.stderr[-2000:]
-    recorder.wait(timeout=60)
+    try:
+        replay = _run([*node, "landing_gear_sim.nodes.replay", "--ros-args", "-p",
+                       f"file:={tmp_path / 'run.csv'}", "-p", "speed:=5.0",
+                       "-p", "wait_for_subscribers:=1"])
+        assert replay.returncode == 0, replay.stderr[-2000:]
+        recorder.wait(timeout=60)
+    finally:
+        recorder.kill()  # no-op once it has left; never outlive the test
+        recorder.wait()
     replayed = read_bag(bag)
     assert len(replayed) == len(measured)
     for field in FIELDS:

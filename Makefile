@@ -1,6 +1,7 @@
 # Two set-up commands on a fresh machine (each makes its own virtual environment):
-#   make demo   - simulate the reference rig, run the ROS 2 node graph and record a bag,
-#                 calibrate and diagnose synthetic campaigns
+#   make demo   - simulate the reference rig, run the ROS 2 node graph in closed loop with
+#                 the threshold anti-skid controller and record a bag, calibrate and
+#                 diagnose synthetic campaigns
 #   make test   - lint and run the test suite
 PYTHON ?= python3
 VENV ?= .venv
@@ -19,12 +20,13 @@ $(STAMP): setup.py setup.cfg
 	touch $(STAMP)
 
 demo: $(STAMP)
-	rm -rf out/brake_const_30bar_bag out/rig_osc_low
+	rm -rf out/brake_const_30bar_bag out/rig_threshold
 	$(BIN)/landing-gear-sim simulate --pressure-bar 30 -o out/brake_const_30bar.csv --bag out/brake_const_30bar_bag
 	$(BIN)/landing-gear-sim simulate --pressure-bar 45 -o out/brake_const_45bar.csv
 	$(BIN)/landing-gear-sim simulate --profile osc-low -o out/brake_osc_low.csv
 	$(BIN)/landing-gear-sim bode -o out/bode.png
-	$(BIN)/landing-gear-sim rig --profile osc-low --bag out/rig_osc_low
+	$(BIN)/landing-gear-sim rig --controller threshold --bag out/rig_threshold
+	$(BIN)/landing-gear-sim metrics out/rig_threshold --plot out/rig_threshold.png
 	rm -rf out/campaign
 	$(BIN)/landing-gear-sim campaign out/campaign --seed 1
 	$(BIN)/landing-gear-sim identify out/campaign -o out/calibrated.yaml

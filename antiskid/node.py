@@ -21,13 +21,10 @@ from landing_gear_sim.nodes.common import (
     Handshake,
     announce_ready,
     declare,
-    lockstep,
     main_for,
-    rig_parameters,
-    run_spec,
+    rig_and_run,
     step_of,
 )
-from landing_gear_sim.runspec import build_scenario
 from msg_tools.contract import TOPIC_CURRENT, TOPIC_FLYWHEEL, TOPIC_WHEEL
 
 from .closed_loop import CONTROLLERS, make_controller, settings_type
@@ -37,9 +34,7 @@ from .errors import ControllerError
 class AntiskidControllerNode(GraphNode):
     def __init__(self) -> None:
         super().__init__("antiskid_controller")
-        rig = rig_parameters(self)
-        lockstep(self)
-        scenario = build_scenario(run_spec(self), rig)
+        rig, scenario, _ = rig_and_run(self)
         kind = str(declare(self, "type", "threshold", "threshold | slip"))
         if kind not in CONTROLLERS:
             raise ControllerError(f"type must be one of {', '.join(CONTROLLERS)}, got {kind!r}")

@@ -3,11 +3,11 @@
 λ = (v − ω r)/v needs the rolling radius r and a speed reference v. r shrinks with the
 load (a few %, as much as the set-point's margin to the friction peak), so the controller
 learns it while the wheel rolls free before braking (r = v/ω averaged over
-``radius_learn_s``), starting from the unloaded radius. The speed reference: the
-flywheel encoder on the rig (``speed_source="flywheel"``), or, on an aircraft, an
-estimate from the wheel speed alone (``"estimate"``: the wheel's peripheral speed, never
-let fall faster than ``max_decel_m_s2``, which a free-rolling wheel reaches between
-releases).
+``radius_learn_s``), starting from the unloaded radius. The speed reference is the
+flywheel encoder (the rig). An estimate from the wheel speed alone (the aircraft case) is
+not offered: a peak hold falling at a fixed deceleration locked the wheel on dry, wet and
+snow alike (no fixed rate fits all three), and a continuous slip controller never lets
+the wheel re-synchronise to correct it. The threshold logic needs no speed reference.
 
 Near the set-point the slip responds to the current like an integrator whose gain falls as
 1/v (λ̇ ≈ r k/(J v) · Δi), so the PI gains grow with v (``kp = kp_per_m_s · v``) to keep the
@@ -23,8 +23,6 @@ from dataclasses import dataclass
 from .common import check_positive
 from .errors import ControllerError
 
-SPEED_SOURCES = ("flywheel", "estimate")
-
 
 @dataclass(frozen=True)
 class SlipParams:
@@ -36,8 +34,6 @@ class SlipParams:
     min_speed_m_s: float = 3.0
     max_current_a: float = 1.0
     initial_current_a: float = 0.3
-    speed_source: str = "flywheel"
-    max_decel_m_s2: float = 12.0
     radius_learn_s: float = 0.5
 
     def __post_init__(self) -> None:
@@ -46,11 +42,9 @@ class SlipParams:
                                   f"{self.slip_setpoint}")
         check_positive("slip", kp_per_m_s=self.kp_per_m_s, ki_per_m_s=self.ki_per_m_s,
                        min_speed_m_s=self.min_speed_m_s, max_current_a=self.max_current_a,
-                       max_decel_m_s2=self.max_decel_m_s2, radius_learn_s=self.radius_learn_s)
+                       radius_learn_s=self.radius_learn_s)
         if not 0.0 <= self.initial_current_a <= self.max_current_a:
             raise ControllerError("slip: initial_current_a must be within [0, max_current_a]")
-        if self.speed_source not in SPEED_SOURCES:
-            raise ControllerError(f"slip: speed_source must be one of {', '.join(SPEED_SOURCES)}")
 
 
 @dataclass
@@ -82,21 +76,10 @@ def learn_radius(params: SlipParams, state: SlipState, wheel_speed_rad_s: float,
         state.radius_count = 0
 
 
-def speed_reference(params: SlipParams, state: SlipState, wheel_speed_rad_s: float,
-                    flywheel_speed_rad_s: float) -> float:
-    """The vehicle (flywheel rim) speed the slip is measured against [m/s]."""
-    if params.speed_source == "flywheel":
-        return flywheel_speed_rad_s * state.flywheel_radius_m
-    wheel = wheel_speed_rad_s * state.wheel_radius_m
-    if math.isnan(state.speed_m_s):
-        return wheel
-    return max(wheel, state.speed_m_s - params.max_decel_m_s2 * state.step_s)
-
-
 def slip_step(params: SlipParams, state: SlipState, time_to_brake_s: float,
               wheel_speed_rad_s: float, flywheel_speed_rad_s: float) -> float:
     """One step: speeds at t_k → valve current [A] held over [t_k, t_k+1); 0 before braking."""
-    speed = speed_reference(params, state, wheel_speed_rad_s, flywheel_speed_rad_s)
+    speed = flywheel_speed_rad_s * state.flywheel_radius_m
     state.speed_m_s = speed
     learn_radius(params, state, wheel_speed_rad_s, speed, time_to_brake_s)
     if time_to_brake_s > 0.0:

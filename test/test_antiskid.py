@@ -131,3 +131,4 @@ def test_metrics_of_an_actuator_only_run_is_one_error_line(tmp_path, capsys, ref
     write_csv(run, tmp_path / "act.csv")
     assert main(["metrics", str(tmp_path / "act.csv")]) == 2
     assert "not a braking run" in capsys.readouterr().err
+

@@ -43,7 +43,7 @@ def test_build_installs_the_ament_index_marker_and_executables(workspace):
     prefix = workspace / "install" / "landing_gear_sim"
     assert (prefix / "share/ament_index/resource_index/packages/landing_gear_sim").is_file()
     for executable in ("landing-gear-sim", "simulate", "bode", "plant", "actuator",
-                       "loading_device", "profile", "recorder", "replay"):
+                       "loading_device", "profile", "recorder", "replay", "antiskid_controller"):
         assert os.access(prefix / "lib/landing_gear_sim" / executable, os.X_OK), executable
     assert (prefix / "share/landing_gear_sim/config/reference_rig.yaml").is_file()
     assert (prefix / "share/landing_gear_sim/launch/rig.launch.py").is_file()

@@ -13,16 +13,12 @@ from msg_tools.contract import ATMOSPHERE_PA, TOPIC_CURRENT
 
 from ..blocks import ActuatorBlock, step_time
 from ..graph import TOPIC_HYDRAULIC
-from ..runspec import build_scenario
 from .common import (
-    DATA_QOS,
     GraphNode,
     Handshake,
     announce_ready,
-    lockstep,
     main_for,
-    rig_parameters,
-    run_spec,
+    rig_and_run,
     to_stamp,
 )
 
@@ -30,15 +26,14 @@ from .common import (
 class ActuatorNode(GraphNode):
     def __init__(self) -> None:
         super().__init__("actuator")
-        params = rig_parameters(self)
-        lockstep(self)  # declared for a uniform graph; the actuator reacts the same in both
-        self._step_s = build_scenario(run_spec(self), params).step_s
+        params, scenario, _ = rig_and_run(self)  # the actuator reacts alike in both clocks
+        self._step_s = scenario.step_s
         self._block = ActuatorBlock(params, self._step_s)
         self._count = 0
         self._message = FluidPressure()
         self._message.header.frame_id = "brake"
-        self._out = self.publisher(FluidPressure, TOPIC_HYDRAULIC, DATA_QOS)
-        current = self.subscription(Float64, TOPIC_CURRENT, self._on_current, DATA_QOS)
+        self._out = self.publisher(FluidPressure, TOPIC_HYDRAULIC)
+        current = self.subscription(Float64, TOPIC_CURRENT, self._on_current)
         Handshake(self, {TOPIC_HYDRAULIC: self._out}, [current], announce_ready(self))
 
     def _on_current(self, message: Float64) -> None:

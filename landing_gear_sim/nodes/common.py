@@ -39,7 +39,8 @@ from msg_tools.errors import RunFormatError
 from ..errors import LandingGearSimError
 from ..graph import TOPIC_READY, TOPIC_RUN_END
 from ..parameters import SPECS, RigParameters, load_parameters
-from ..runspec import RunSpec
+from ..runspec import RunSpec, build_scenario
+from ..scenario import Scenario
 
 DATA_QOS = QoSProfile(reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST,
                       depth=5000, durability=DurabilityPolicy.VOLATILE)
@@ -86,6 +87,16 @@ def run_spec(node: Node) -> RunSpec:
         contact=str(declare(node, "run.contact", "auto", "auto | rig | actuator")),
         duration_s=float(declare(node, "run.duration_s", 0.0, "input duration [s], 0: default")),
         rate_hz=float(declare(node, "run.rate_hz", 0.0, "exchange rate [Hz], 0: from config")))
+
+
+def rig_and_run(node: Node) -> tuple[RigParameters, Scenario, bool]:
+    """Declare what every graph node shares: the model, the run and the clock.
+
+    Returns the parameter set, the run's scenario (its rate is the exchange rate) and
+    whether the graph runs in lockstep.
+    """
+    params = rig_parameters(node)
+    return params, build_scenario(run_spec(node), params), lockstep(node)
 
 
 def lockstep(node: Node) -> bool:

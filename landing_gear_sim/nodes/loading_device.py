@@ -9,16 +9,12 @@ from msg_tools.contract import TOPIC_FLYWHEEL
 
 from ..blocks import LoadingBlock, step_time
 from ..graph import TOPIC_LOAD
-from ..runspec import build_scenario
 from .common import (
-    DATA_QOS,
     GraphNode,
     Handshake,
     announce_ready,
-    lockstep,
     main_for,
-    rig_parameters,
-    run_spec,
+    rig_and_run,
     step_of,
     to_stamp,
 )
@@ -27,15 +23,13 @@ from .common import (
 class LoadingDeviceNode(GraphNode):
     def __init__(self) -> None:
         super().__init__("loading_device")
-        params = rig_parameters(self)
-        lockstep(self)
-        scenario = build_scenario(run_spec(self), params)
+        params, scenario, _ = rig_and_run(self)
         self._rate_hz, self._step_s = scenario.rate_hz, scenario.step_s
         self._block = LoadingBlock(params, scenario.step_s, scenario.contact)
         self._message = Vector3Stamped()
         self._message.header.frame_id = "gear"
-        self._out = self.publisher(Vector3Stamped, TOPIC_LOAD, DATA_QOS)
-        speed = self.subscription(JointState, TOPIC_FLYWHEEL, self._on_speed, DATA_QOS)
+        self._out = self.publisher(Vector3Stamped, TOPIC_LOAD)
+        speed = self.subscription(JointState, TOPIC_FLYWHEEL, self._on_speed)
         Handshake(self, {TOPIC_LOAD: self._out}, [speed], announce_ready(self))
 
     def _on_speed(self, message: JointState) -> None:

@@ -28,17 +28,14 @@ from msg_tools.contract import (
 
 from ..blocks import PlantBlock, SensorSample
 from ..graph import TOPIC_CLOCK, TOPIC_HYDRAULIC, TOPIC_LOAD, TOPIC_READY, TOPIC_RUN_END
-from ..runspec import build_scenario
 from .common import (
     DATA_QOS,
     LATCHED_QOS,
     GraphNode,
     Handshake,
     declare,
-    lockstep,
     main_for,
-    rig_parameters,
-    run_spec,
+    rig_and_run,
     step_of,
     to_stamp,
 )
@@ -50,9 +47,7 @@ LOST_CHUNK = 500  # steps per watchdog tick once every input is lost: keep the e
 class PlantNode(GraphNode):
     def __init__(self) -> None:
         super().__init__("plant")
-        params = rig_parameters(self)
-        self._scenario = build_scenario(run_spec(self), params)
-        self._lockstep = lockstep(self)
+        params, self._scenario, self._lockstep = rig_and_run(self)
         noise = declare(self, "sensor_noise", False, "add sensors.* noise to the outputs")
         seed = int(declare(self, "noise_seed", 0, "seed of the sensor noise"))
         self._timeout_s = float(declare(self, "timeout_s", 10.0,
@@ -69,13 +64,13 @@ class PlantNode(GraphNode):
         self._ready: set[str] = set()
         self._linked = self._started = self._done = False
         self._messages = _Messages()
-        self._out = {topic: self.publisher(kind, topic, DATA_QOS) for topic, kind in (
+        self._out = {topic: self.publisher(kind, topic) for topic, kind in (
             (TOPIC_CLOCK, Clock), (TOPIC_FLYWHEEL, JointState), (TOPIC_WHEEL, JointState),
             (TOPIC_PRESSURE, FluidPressure), (TOPIC_WRENCH, WrenchStamped))}
         self._end = self.publisher(UInt64, TOPIC_RUN_END, LATCHED_QOS)
         inputs = [self.subscription(FluidPressure, TOPIC_HYDRAULIC, self._on_pressure,
                                     DATA_QOS),
-                  self.subscription(Vector3Stamped, TOPIC_LOAD, self._on_load, DATA_QOS)]
+                  self.subscription(Vector3Stamped, TOPIC_LOAD, self._on_load)]
         self.subscription(String, TOPIC_READY, self._on_ready, LATCHED_QOS)
         self._handshake = Handshake(self, self._out, inputs, self._on_linked)
         self._last_progress = time.monotonic()

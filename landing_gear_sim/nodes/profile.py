@@ -12,16 +12,12 @@ from std_msgs.msg import Float64
 
 from msg_tools.contract import TOPIC_CURRENT, TOPIC_WHEEL
 
-from ..runspec import build_scenario
 from .common import (
-    DATA_QOS,
     GraphNode,
     Handshake,
     announce_ready,
-    lockstep,
     main_for,
-    rig_parameters,
-    run_spec,
+    rig_and_run,
     step_of,
 )
 
@@ -42,8 +38,8 @@ class CurrentFeed:
         self._rate_hz = rate_hz
         self._lead = 1 if ahead else 0
         self._message = Float64()
-        self._out = node.publisher(Float64, TOPIC_CURRENT, DATA_QOS)
-        wheel = node.subscription(JointState, TOPIC_WHEEL, self._on_sample, DATA_QOS)
+        self._out = node.publisher(Float64, TOPIC_CURRENT)
+        wheel = node.subscription(JointState, TOPIC_WHEEL, self._on_sample)
         Handshake(node, {TOPIC_CURRENT: self._out}, [wheel], announce_ready(node))
 
     def _on_sample(self, message: JointState) -> None:
@@ -57,9 +53,7 @@ class CurrentFeed:
 class ProfileNode(GraphNode):
     def __init__(self) -> None:
         super().__init__("profile")
-        params = rig_parameters(self)
-        ahead = lockstep(self)
-        scenario = build_scenario(run_spec(self), params)
+        _, scenario, ahead = rig_and_run(self)
         self._feed = CurrentFeed(self, scenario.current_a, scenario.rate_hz, ahead)
 
 

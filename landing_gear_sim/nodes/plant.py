@@ -75,6 +75,7 @@ class PlantNode(GraphNode):
         self._handshake = Handshake(self, self._out, inputs, self._on_linked)
         self._last_progress = time.monotonic()
         self._wall_start = 0.0
+        self._published_at: list[float] = []  # real time: wall time of each step's sample
         self.create_timer(min(self._timeout_s / 4, 0.1), self._watchdog)
         mode = "lockstep" if self._lockstep else "real time"
         self.get_logger().info(f"{self._scenario.name}: up to {self._plant.n_steps} steps at "
@@ -130,6 +131,7 @@ class PlantNode(GraphNode):
         due = int((time.monotonic() - self._wall_start) * self._rate_hz)
         while not self._done and self._plant.step_index < due:
             self._step(self._latest[ACTUATOR], self._latest[LOADING])
+            self._published_at.append(time.monotonic())
 
     def _step(self, pressure_pa: float, load_n: float) -> None:
         self._plant.advance(pressure_pa, load_n)
@@ -149,6 +151,11 @@ class PlantNode(GraphNode):
         sim = samples / self._rate_hz
         self.get_logger().info(f"run ends after {samples} samples ({sim:.3f} s sim time) in "
                                f"{wall:.2f} s wall: real-time factor {sim / max(wall, 1e-9):.2f}")
+        if len(self._published_at) > 2:
+            periods = np.diff(self._published_at)
+            jitter = np.percentile(np.abs(periods - 1.0 / self._rate_hz), 99)
+            self.get_logger().info(f"real-time pacing: p99 period jitter {jitter * 1e3:.3f} ms "
+                                   f"at the plant over {periods.size} periods")
         self._end.publish(UInt64(data=samples))
 
     # --- faults -------------------------------------------------------------------------

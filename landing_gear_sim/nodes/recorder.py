@@ -6,9 +6,12 @@ current command is logged at the stamp of sample j+1, as the data contract reads
 (the command in force over the interval that ends there). So the same run gives the
 same bag files, whatever the machine load.
 
-The bag is written in segments of ``segment_s`` of sim time (see
-:mod:`msg_tools.bag_segments`): SIGINT/SIGTERM close it complete; after SIGKILL the
-bag still opens and lacks only the open segment.
+The bag is written in segments (see :mod:`msg_tools.bag_segments`) of at least
+``segment_s`` of sim time and ``segment_samples`` samples — a rule on the data, so the
+files are the same on every run. SIGINT/SIGTERM close the bag complete; after SIGKILL it
+still opens and lacks only the open segment: about half a second of wall time at the
+graph's real-time factors (closing a segment costs ~30 ms, so at a high real-time factor
+the sample floor keeps the recorder from spending its time closing segments).
 """
 
 from __future__ import annotations
@@ -52,6 +55,9 @@ class RecorderNode(GraphNode):
         storage = str(declare(self, "storage", "mcap", "mcap | sqlite3"))
         self._segment_ns = round(float(declare(self, "segment_s", 0.5, "sim time per closed "
                                                "segment [s]: the most a crash loses")) * 1e9)
+        self._segment_samples = int(declare(self, "segment_samples", 500,
+                                            "fewest samples per closed segment"))
+        self._in_segment = 0
         if not path:
             raise LandingGearSimError("recorder needs the parameter bag:=FOLDER")
         self._writer = SegmentedBagWriter(Path(path), TOPIC_TYPES, storage)
@@ -101,9 +107,11 @@ class RecorderNode(GraphNode):
         stamp = self._order[index]
         if self._segment_start is None:
             self._segment_start = stamp
-        elif stamp - self._segment_start >= self._segment_ns:
+        elif (stamp - self._segment_start >= self._segment_ns
+              and self._in_segment >= self._segment_samples):
             self._writer.roll()
-            self._segment_start = stamp
+            self._segment_start, self._in_segment = stamp, 0
+        self._in_segment += 1
         if 0 < index <= len(self._currents):
             self._writer.write(TOPIC_CURRENT, stamp, self._currents[index - 1])
         messages = self._samples.pop(stamp, {})

@@ -15,6 +15,7 @@ import scipy.signal
 
 from landing_gear_sim.errors import LandingGearSimError
 from landing_gear_sim.parameters import RigParameters
+from landing_gear_sim.plant import rolling_radius_at
 from msg_tools.run import Run
 
 LOCK_SLIP = 0.95  # a wheel at 95 % slip or more is locked
@@ -60,14 +61,6 @@ def gear_walk_frequency_hz(rig: RigParameters) -> float:
     return math.sqrt(rig.number("gear_walk.stiffness_n_m_per_rad") / inertia) / (2 * math.pi)
 
 
-def rolling_radius(rig: RigParameters, load_n: np.ndarray) -> np.ndarray:
-    radius = np.full_like(load_n, rig.number("wheel.unloaded_radius_m"))
-    if rig.has("load_dependent_radius"):
-        radius -= (rig.number("radius.a_m_per_n2") * load_n ** 2
-                   + rig.number("radius.b_m_per_n") * load_n + rig.number("radius.c_m"))
-    return radius
-
-
 def braking_window(run: Run) -> slice:
     """From the first commanded current to the end of the run."""
     active = np.flatnonzero(run.current_a > 1e-3)
@@ -77,19 +70,27 @@ def braking_window(run: Run) -> slice:
     return slice(int(active[0]), len(run))
 
 
-def slip_of(run: Run, rig: RigParameters) -> np.ndarray:
-    speed = run.flywheel_speed_rad_s * rig.number("flywheel.radius_m")
-    wheel = run.wheel_speed_rad_s * rolling_radius(rig, np.maximum(run.vertical_load_n, 0.0))
-    return np.where(speed > 0.5, (speed - wheel) / np.maximum(speed, 0.5), 0.0)
+def speeds_m_s(run: Run, rig: RigParameters) -> tuple[np.ndarray, np.ndarray]:
+    """Flywheel rim (vehicle) speed and wheel peripheral speed at the rolling radius [m/s]."""
+    vehicle = run.flywheel_speed_rad_s * rig.number("flywheel.radius_m")
+    wheel = run.wheel_speed_rad_s * rolling_radius_at(rig, np.maximum(run.vertical_load_n, 0.0))
+    return vehicle, wheel
+
+
+def slip_from(vehicle_m_s: np.ndarray, wheel_m_s: np.ndarray) -> np.ndarray:
+    """λ = (v − ωr)/v, 0 where the vehicle is (almost) at rest."""
+    return np.where(vehicle_m_s > 0.5, (vehicle_m_s - wheel_m_s) / np.maximum(vehicle_m_s, 0.5),
+                    0.0)
 
 
 def braking_metrics(run: Run, rig: RigParameters) -> BrakingMetrics:
     """Metrics of the braking phase of ``run`` on the rig ``rig``."""
     window = braking_window(run)
     t = run.time_s[window]
-    speed = run.flywheel_speed_rad_s[window] * rig.number("flywheel.radius_m")
+    vehicle, wheel = speeds_m_s(run, rig)
+    speed = vehicle[window]
     load = run.vertical_load_n[window]
-    slip = slip_of(run, rig)[window]
+    slip = slip_from(vehicle, wheel)[window]
     loaded = load > MIN_LOAD_N
     friction = run.longitudinal_force_n[window][loaded] / load[loaded]
     peak, _ = peak_friction(rig)

@@ -6,6 +6,7 @@ Every user error ends as one line ``landing-gear-sim: error: ...`` and exit code
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import sys
 import time
@@ -201,7 +202,7 @@ def cmd_antiskid(args: argparse.Namespace) -> int:
     controller = make_controller(args.controller, rig, step_s, settings)
     _progress(f"{args.controller} controller on the {args.surface} surface, closed loop")
     run = closed_loop(rig, controller, args.rate or 0.0).to_run()
-    run = type(run)(**{**run.__dict__, "name": f"{args.controller}_{args.surface}"})
+    run = dataclasses.replace(run, name=f"{args.controller}_{args.surface}")
     metrics = braking_metrics(run, rig)
     _progress("constant-pressure baseline just below the skid pressure (bisection)")
     pressure, baseline = constant_pressure_baseline(rig)
@@ -235,7 +236,7 @@ def _write_braking_outputs(args: argparse.Namespace, run: Run, rig: RigParameter
                            metrics: BrakingMetrics, default_plot: Path | None = None) -> None:
     import json
 
-    from antiskid.metrics import rolling_radius, slip_of
+    from antiskid.metrics import slip_from, speeds_m_s
     from antiskid.plotting import plot_braking
 
     if args.json:
@@ -244,9 +245,8 @@ def _write_braking_outputs(args: argparse.Namespace, run: Run, rig: RigParameter
         print(f"  json: {args.json}")
     plot = args.plot or default_plot
     if plot is not None:
-        wheel = run.wheel_speed_rad_s * rolling_radius(rig, np.maximum(run.vertical_load_n, 0))
-        flywheel = run.flywheel_speed_rad_s * rig.number("flywheel.radius_m")
-        path = plot_braking(run, slip_of(run, rig), wheel, flywheel, metrics, plot)
+        vehicle, wheel = speeds_m_s(run, rig)
+        path = plot_braking(run, slip_from(vehicle, wheel), wheel, vehicle, metrics, plot)
         print(f"  plot: {path}")
 
 

@@ -33,7 +33,7 @@ from msg_tools.run import Run
 from . import elements as el
 from .errors import ParameterError
 from .parameters import RigParameters
-from .plant import actuator_matrices, actuator_state, actuator_step
+from .plant import actuator_matrices, actuator_state, actuator_step, rolling_radius_at
 from .scenario import logged_to_held
 
 FILTER_HZ = 20.0  # zero-phase low-pass before differentiating speeds
@@ -275,12 +275,6 @@ def _free_rolling(b: _Braking) -> np.ndarray:
     return (b.time_s > b.start_s - 1.0) & (b.time_s < b.start_s - 0.05) & (b.load > 5e3)
 
 
-def _radius(p: RigParameters, load: np.ndarray) -> np.ndarray:
-    """Rolling radius of eq. (9) at the measured loads (r0 if the element is off)."""
-    vector = p.vector()
-    return np.array([el.rolling_radius(vector, f) for f in load])
-
-
 def _hub_speed(b: _Braking, p: RigParameters) -> np.ndarray:
     """v_h = v_f − L θ̇, θ from the measured F_x through the gear's spring-damper (eq. 6)."""
     if not p.has("gear_walk"):
@@ -301,7 +295,7 @@ def fit_unloaded_radius(runs: Sequence[_Braking], p: RigParameters) -> Estimate:
         if m.sum() > 50:
             r_eff = np.mean(b.speed_m_s[m]) / np.mean(b.wheel[m])
             values.append(r_eff + (p.number("wheel.unloaded_radius_m")
-                                   - float(np.mean(_radius(p, b.load[m])))))
+                                   - float(np.mean(rolling_radius_at(p, b.load[m])))))
     if not values:
         raise ValueError("no free-rolling phase before braking")
     std = float(np.std(values) / math.sqrt(len(values))) if len(values) > 1 else float("nan")
@@ -347,7 +341,7 @@ def fit_flywheel(runs: Sequence[_Braking], p: RigParameters) -> list[Estimate]:
 
 def _torque_balance(b: _Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
     """Brake torque r F_x − J_w ω̇ [N m] and the energy the brake absorbed, ∫ T_b ω dt [J]."""
-    torque = _radius(p, b.load) * b.force - p.number("wheel.inertia_kg_m2") * b.wheel_rate
+    torque = rolling_radius_at(p, b.load) * b.force - p.number("wheel.inertia_kg_m2") * b.wheel_rate
     dt = np.diff(b.time_s, prepend=b.time_s[0])
     power = np.where(b.time_s > b.start_s - 0.1, np.clip(torque, 0, None), 0.0) \
         * np.clip(b.wheel, 0, None)
@@ -401,7 +395,7 @@ def friction_samples(runs: Sequence[_Braking], p: RigParameters
         m = (b.time_s > b.start_s + 0.3) & (b.speed_m_s > stop + 2.0) & (b.load > 5e3) \
             & (b.wheel > 1.0)
         idx = np.flatnonzero(m)[::10]
-        radius = _radius(p, b.load[idx])
+        radius = rolling_radius_at(p, b.load[idx])
         slips.append(1.0 - b.wheel[idx] * radius / _hub_speed(b, p)[idx])
         mus.append(b.force[idx] / b.load[idx])
     return np.concatenate(slips), np.concatenate(mus)

@@ -30,7 +30,7 @@ import scipy.linalg
 from numba import njit
 
 from . import elements as el
-from .parameters import INDEX
+from .parameters import INDEX, RigParameters
 
 SPEED, ANGLE, ANGLE_RATE, OMEGA, E_BRAKE, E_DRAG, E_SLIP, E_DAMP, TYRE_FORCE = range(9)
 N_STATES = 9
@@ -96,6 +96,13 @@ def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     dx[E_DAMP] = p[el.GW_DAMPING] * x[ANGLE_RATE] ** 2 if p[el.HAS_GEAR_WALK] else 0.0
     steady = vertical_load_n * el.burckhardt(p, slip)
     dx[TYRE_FORCE] = el.relaxation_rate(p, hub) * (steady - x[TYRE_FORCE])
+
+
+def rolling_radius_at(params: RigParameters, load_n: np.ndarray) -> np.ndarray:
+    """Rolling radius of eq. (9) at each vertical load [N] → [m], same shape; r0 when the
+    ``load_dependent_radius`` element is off. The compiled law itself, once per sample."""
+    vector = params.vector()
+    return np.array([el.rolling_radius(vector, f) for f in np.asarray(load_n, dtype=float)])
 
 
 @njit(cache=True)

@@ -49,6 +49,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/identify.py
 	$(BIN)/python bench/graph.py
 	$(BIN)/python bench/controllers.py
+	$(BIN)/python bench/diagnose.py
 
 clean:
 	rm -rf $(VENV) out build install log .pytest_cache

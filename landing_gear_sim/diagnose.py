@@ -184,7 +184,8 @@ def split_runs(candidate: Candidate, runs: Sequence[Run]) -> tuple[list[Run], li
     of each class are sorted by length and alternate between the two sets (the
     shorter to fitting), so both see every kind of test.
     """
-    own = select_runs(runs, candidate.runs)
+    own = select_runs(runs, candidate.runs) or select_runs(
+        runs, tuple(kind.split("_")[0] for kind in candidate.runs))
     others = select_runs(runs, candidate.held_out)
     if own and others:
         return own, others

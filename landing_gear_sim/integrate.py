@@ -57,6 +57,16 @@ def run_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed,
     return n, 0
 
 
+@njit(cache=True)
+def actuator_kernel(p, matrices, current, out):
+    """The pressure column ``run_kernel`` records, from the actuator alone (it does not
+    depend on the wheel): ``out[0]`` = 0, ``out[k+1]`` after step k with ``current[k]``."""
+    xa = actuator_state(matrices)
+    out[0] = 0.0
+    for k in range(current.shape[0] - 1):
+        out[k + 1] = actuator_step(p, matrices, xa, current[k])
+
+
 @njit(cache=True, parallel=True)
 def batch_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed, out, rows, stop):
     """``run_kernel`` over parameter sets ``p`` (m, N_PARAMS) in parallel; inputs (m, n)."""
@@ -90,6 +100,16 @@ class SimulationResult:
         if not self.params.has("pressure_sensor_offset"):
             return 0.0
         return self.params.number("sensors.pressure_offset_pa")
+
+    def sensed_pressure_to_end(self) -> np.ndarray:
+        """Brake pressure as the transducer reads it (offset, no noise) over the whole
+        input, (n,) [Pa]: after a stop at the stop speed the valve still follows its
+        current, so a measured run's pressure goes on after the simulation stopped."""
+        vector = self.params.vector()
+        pressure = np.empty(self.scenario.current_a.size)
+        actuator_kernel(vector, actuator_matrices(vector, self.scenario.step_s),
+                        self.scenario.current_a, pressure)
+        return pressure + self._pressure_offset_pa()
 
     def to_run(self, noise_seed: int | None = None) -> Run:
         """The run as the rig's sensors would log it (data contract), with sensor noise.

@@ -77,8 +77,9 @@ def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult
     """Simulate ``run`` with its measured current; the result on the run's time base.
 
     If the model stops (speed below 1 m/s) before the measurement ends, the last
-    simulated sample is held, so both have the same length. The touch-down time is
-    the run's start, as in the rig procedure.
+    simulated sample is held, so both have the same length, except the pressure: the
+    valve goes on following the measured current. The touch-down time is the run's
+    start, as in the rig procedure.
     """
     uniform = run if is_uniform(run, 1e-3) else resample(run, round(run.rate_hz))
     result = simulate(params, scenario_for_run(uniform, params))
@@ -86,6 +87,8 @@ def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult
     n, m = len(uniform), len(simulated)
     take = np.minimum(np.arange(n), m - 1)
     fields = {name: getattr(simulated, name)[take] for name in CHANNELS}
+    if m < n:
+        fields["pressure_pa"] = result.sensed_pressure_to_end()[:n]
     return Run(name=run.name, source="simulation", time_s=uniform.time_s,
                current_a=uniform.current_a, **fields), result
 

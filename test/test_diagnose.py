@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from landing_gear_sim.campaign import generate_campaign, rig_like
-from landing_gear_sim.catalogue import gear_walk_key_parameters
+from landing_gear_sim.catalogue import CATALOGUE, gear_walk_key_parameters
 from landing_gear_sim.cli import main
-from landing_gear_sim.diagnose import DiagnosisError, diagnose
+from landing_gear_sim.diagnose import DiagnosisError, diagnose, split_runs
 from msg_tools.csv_io import read_csv, write_csv
 from msg_tools.io import read_campaign
 
@@ -115,10 +115,12 @@ def test_without_actuator_dynamics_the_valve_dynamics_are_rediscovered(reference
 
 @pytest.mark.slow
 def test_without_load_dependent_radius_it_is_rediscovered(reference, tmp_path):
-    runs, rig = _campaign(reference, tmp_path, 112)
+    runs, rig = _campaign(reference, tmp_path, 112, lambda rng: {
+        "radius.b_m_per_n": reference.number("radius.b_m_per_n") * rng.uniform(0.7, 1.5)})
     result = diagnose(runs, reference, without=["load_dependent_radius"])
     assert result.verdict == "load_dependent_radius"
     found = _finding(result, "load_dependent_radius").parameters
+    assert found["radius_b_m_per_n"] == pytest.approx(rig.number("radius.b_m_per_n"), rel=0.3)
     load = float(np.median(np.concatenate([r.vertical_load_n for r in runs
                                            if r.name.startswith("brake")])))
     # a and b trade off at the loads of one campaign: check the radius change they make
@@ -152,6 +154,19 @@ def test_an_effect_outside_the_catalogue_is_not_given_a_catalogue_name(reference
     result = diagnose(read_campaign(tmp_path).runs, reference)
     assert [f.cause for f in result.findings] == ["unexplained"]
     assert result.findings[0].parameters["frequency_hz"] == pytest.approx(frequency, abs=0.5)
+
+
+def test_relaxation_is_fitted_on_constant_stops_or_else_on_any_braking_run(reference,
+                                                                          tmp_path):
+    runs, _ = _campaign(reference, tmp_path, 114)
+    relaxation = CATALOGUE["tire_relaxation"]
+    fit, held = split_runs(relaxation, runs)
+    assert {r.name for r in fit} == {"brake_const_40bar"}  # the shorter one
+    assert {r.name for r in held} == {"brake_const_30bar"}
+    oscillating = [r for r in runs if r.name.startswith("brake_osc")]
+    fit, held = split_runs(relaxation, oscillating)
+    assert len(fit) == len(held) == 1
+    assert {r.name for r in fit + held} == {r.name for r in oscillating}
 
 
 def test_unknown_element_to_remove_is_a_clear_error(reference, tmp_path):

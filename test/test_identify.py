@@ -12,7 +12,7 @@ from landing_gear_sim.campaign import DEVIATING, generate_campaign, rig_like
 from landing_gear_sim.cli import main
 from landing_gear_sim.identify import classify, identify
 from landing_gear_sim.parameters import load_parameters
-from landing_gear_sim.validate import validate
+from landing_gear_sim.validate import fit_percent, simulate_run, validate
 from msg_tools.io import read_campaign
 
 SEED = 11  # the hidden rig: datasheet values off by up to ±3 %, never shown to identify()
@@ -134,3 +134,21 @@ def test_campaign_cli_refuses_to_overwrite(tmp_path, capsys):
     assert "not empty" in capsys.readouterr().err
     assert main(["campaign", str(tmp_path / "new"), "--seed", "3"]) == 0
     assert len(list((tmp_path / "new").glob("*.csv"))) == 8
+
+
+def test_a_model_that_stops_early_still_follows_the_valve_pressure(campaign_dir, reference):
+    """The valve does not depend on the wheel: after the model's stop its pressure goes on
+    following the measured current (holding it made a stronger brake look like a worse
+    actuator)."""
+    run = next(r for r in read_campaign(campaign_dir).runs if r.name == "brake_osc_low")
+    strong = reference.replace({"brake.gain_n_m_per_pa": 1.5 * reference.number(
+        "brake.gain_n_m_per_pa")}, "test")
+    simulated, result = simulate_run(run, strong)
+    stopped = len(result)
+    assert stopped < len(run) - 500
+    assert np.array_equal(simulated.pressure_pa[:stopped], result.pressure_pa)
+    assert np.ptp(simulated.pressure_pa[stopped:]) > 5e5  # still oscillating
+    held = simulated.wheel_speed_rad_s[stopped:]
+    assert np.all(held == held[0])
+    tail = slice(stopped, None)
+    assert fit_percent(run.pressure_pa[tail], simulated.pressure_pa[tail]) > 90.0

@@ -9,6 +9,7 @@ Targets are reported, never asserted.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import subprocess
@@ -53,8 +54,10 @@ def realtime_periods(duration_s: float) -> tuple[float, float, float]:
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import JointState
 
+    from landing_gear_sim.nodes.common import spin
+
     rclpy.init()
-    node = rclpy.create_node("bench_listener")
+    node = rclpy.create_node("bench_listener", start_parameter_services=False)
     arrivals: list[float] = []
     stamps: list[float] = []
 
@@ -69,11 +72,17 @@ def realtime_periods(duration_s: float) -> tuple[float, float, float]:
         [sys.executable, "-m", "landing_gear_sim", "rig", "--profile", "sweep", "--duration",
          str(duration_s), "--clock", "realtime", "--no-bag", "--rate", str(REALTIME_RATE_HZ)],
         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    while graph.poll() is None:
-        rclpy.spin_once(node, timeout_sec=0.1)
-    drain_until = time.monotonic() + 2.0  # messages still queued when the graph left
-    while time.monotonic() < drain_until:
-        rclpy.spin_once(node, timeout_sec=0.05)
+    left: list[float] = []
+
+    def watch() -> None:
+        if graph.poll() is not None and not left:
+            left.append(time.monotonic())
+        if left and time.monotonic() > left[0] + 2.0:  # drained what was still queued
+            raise _DoneError
+
+    node.create_timer(0.1, watch)
+    with contextlib.suppress(_DoneError):
+        spin(node)  # the nodes' own lean loop: rclpy's executor adds its own jitter
     node.destroy_node()
     rclpy.shutdown()
     at_plant = re.search(r"p99 period jitter ([0-9.]+) ms", graph.stderr.read())
@@ -83,6 +92,10 @@ def realtime_periods(duration_s: float) -> tuple[float, float, float]:
     expected = round((stamps[-1] - stamps[0]) * REALTIME_RATE_HZ) + 1
     return (len(set(stamps)) / expected, float(np.percentile(jitter, 99)),
             float(at_plant.group(1)) * 1e-3 if at_plant else float("nan"))
+
+
+class _DoneError(Exception):
+    """The graph has left and its last messages are in."""
 
 
 def ping_pong_rate(duration_s: float) -> float:

@@ -128,7 +128,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def cmd_rig(args: argparse.Namespace) -> int:
-    from .graph import GraphOptions
+    from .graph import GraphOptions, controlled_run
     from .launcher import run_graph
 
     params = _params(args)
@@ -136,8 +136,7 @@ def cmd_rig(args: argparse.Namespace) -> int:
     if args.replay is not None:
         spec = RunSpec(profile="file", file=str(args.replay), contact=spec.contact,
                        rate_hz=spec.rate_hz)
-    if args.controller is not None:
-        spec = RunSpec(profile="external", rate_hz=spec.rate_hz)
+    spec = controlled_run(spec, args.controller)
     scenario = build_scenario(spec, params)  # fail here, not in five processes
     bag = None if args.no_bag else args.bag or Path("out") / "rig" / (
         f"{scenario.name}_{time.strftime('%Y%m%d-%H%M%S')}")

@@ -77,7 +77,7 @@ class GraphOptions:
             the profile node.
     """
     # a controller graph is a rig test braking from rig_test.brake_start_s: run.profile
-    # is "external" (see options_from_arguments and the rig command)
+    # is "external" (see controlled_run)
 
     run: RunSpec = field(default_factory=RunSpec)
     clock: str = "lockstep"
@@ -113,6 +113,12 @@ LAUNCH_ARGUMENTS: dict[str, tuple[str, str]] = {
 """Launch-file arguments: name -> (default, description)."""
 
 
+def controlled_run(run: RunSpec, controller: str | None) -> RunSpec:
+    """The run of a graph: ``run``, or with a controller driving the brake, a rig test
+    at the same rate whose current comes from outside (profile ``external``)."""
+    return RunSpec(profile="external", rate_hz=run.rate_hz) if controller else run
+
+
 def options_from_arguments(values: dict[str, str]) -> tuple[GraphOptions, Path]:
     """GraphOptions and params file from launch arguments (strings, see LAUNCH_ARGUMENTS)."""
     from .parameters import default_config_files
@@ -126,8 +132,8 @@ def options_from_arguments(values: dict[str, str]) -> tuple[GraphOptions, Path]:
         raise LandingGearSimError(
             f"pressure_bar must be a number, got {value('pressure_bar')!r}") from None
     controller = value("controller") or None
-    run = RunSpec(profile="external" if controller else value("profile"), file=value("file"),
-                  pressure_pa=pressure_pa)
+    run = controlled_run(RunSpec(profile=value("profile"), file=value("file"),
+                                 pressure_pa=pressure_pa), controller)
     options = GraphOptions(run=run, clock=value("clock"), storage=value("storage"),
                            bag=Path(value("bag")) if value("bag") else None,
                            controller=controller)

@@ -153,6 +153,7 @@ def test_realtime_graph_follows_the_wall_clock(tmp_path):
     assert time.monotonic() - started > 1.5
     rtf = float(re.search(r"real-time factor ([0-9.]+)", done.stderr).group(1))
     assert rtf <= 1.05  # paced by the wall clock: never faster (slower only if starved)
+    assert "real-time pacing: p99 period jitter" in done.stderr  # how well, said at the end
 
 
 def test_replay_publishes_a_run_that_the_recorder_writes_back(tmp_path, reference):

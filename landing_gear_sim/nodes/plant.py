@@ -115,7 +115,7 @@ class PlantNode(GraphNode):
     def _ask_realtime_scheduling(self) -> None:
         """SCHED_FIFO for this thread: on 2 cores shared with four other nodes, a plant
         under the ordinary scheduler was preempted often enough to miss 1 ms at p99
-        (measured: p99 period jitter 0.97-1.15 ms without, 0.14-0.18 ms with)."""
+        (measured: p99 period jitter 0.97-1.15 ms without, 0.14-0.34 ms with)."""
         if self._priority <= 0:
             return
         try:

@@ -155,7 +155,9 @@ def noise_scales(runs: Sequence[Run], channels: Sequence[str]) -> Scales:
 def select_runs(runs: Sequence[Run], kinds: Sequence[str]) -> list[Run]:
     """Runs of one of ``kinds``: a family ("actuator", "brake") or a class
     ("brake_constant", see identify.classify)."""
-    return [r for r in runs if classify(r) in kinds or classify(r).split("_")[0] in kinds]
+    classes = [classify(r) for r in runs]  # classify reads the signals: once per run
+    return [r for r, c in zip(runs, classes, strict=True)
+            if c in kinds or c.split("_")[0] in kinds]
 
 
 def simulate_all(runs: Sequence[Run], params: RigParameters) -> list[Run]:

@@ -56,7 +56,7 @@ setup(
             "simulate = landing_gear_sim.cli:simulate_main",
             "bode = landing_gear_sim.cli:bode_main",
             # the nodes: `ros2 run landing_gear_sim <name>` after colcon build
-            *(f"{node} = landing_gear_sim.nodes.{node}:main" for node in NODES),
+            *(f"{node} = landing_gear_sim.ros.nodes.{node}:main" for node in NODES),
             "antiskid_controller = antiskid.node:main",
         ],
     },

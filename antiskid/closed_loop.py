@@ -11,10 +11,10 @@ from dataclasses import fields
 
 import numpy as np
 
-from landing_gear_sim.blocks import ActuatorBlock, LoadingBlock, PlantBlock
-from landing_gear_sim.integrate import SimulationResult
-from landing_gear_sim.parameters import RigParameters
-from landing_gear_sim.runspec import RunSpec, build_scenario
+from landing_gear_sim.model.blocks import ActuatorBlock, LoadingBlock, PlantBlock
+from landing_gear_sim.model.integrate import SimulationResult
+from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.runspec import RunSpec, build_scenario
 
 from .errors import ControllerError
 from .slip import SlipParams, slip_state, slip_step
@@ -105,8 +105,8 @@ def constant_pressure_baseline(rig: RigParameters, margin: float = 0.98,
     The skid pressure is found by bisection between 0 and the valve's maximum; the
     baseline brakes at ``margin`` times it. Returns (pressure [Pa], the simulated stop).
     """
-    from landing_gear_sim.integrate import simulate
-    from landing_gear_sim.scenario import constant_pressure_test
+    from landing_gear_sim.model.integrate import simulate
+    from landing_gear_sim.model.scenario import constant_pressure_test
 
     from .metrics import braking_metrics
 

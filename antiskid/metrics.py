@@ -14,8 +14,8 @@ import scipy.integrate
 import scipy.signal
 
 from landing_gear_sim.errors import LandingGearSimError
-from landing_gear_sim.parameters import RigParameters
-from landing_gear_sim.plant import rolling_radius_at
+from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.plant import rolling_radius_at
 from msg_tools.run import Run
 
 LOCK_SLIP = 0.95  # a wheel at 95 % slip or more is locked

@@ -15,8 +15,8 @@ from dataclasses import fields
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
-from landing_gear_sim.blocks import step_time
-from landing_gear_sim.nodes.common import (
+from landing_gear_sim.model.blocks import step_time
+from landing_gear_sim.ros.nodes.common import (
     GraphNode,
     Handshake,
     announce_ready,

@@ -17,7 +17,7 @@ from antiskid.closed_loop import (
     with_surface,
 )
 from antiskid.metrics import braking_metrics
-from landing_gear_sim.parameters import load_parameters
+from landing_gear_sim.model.parameters import load_parameters
 
 TARGETS = {"threshold": 0.80, "slip": 0.92}
 SURFACES = ("dry", "wet", "snow")

@@ -18,10 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from landing_gear_sim.campaign import generate_campaign, rig_like
-from landing_gear_sim.catalogue import simulate_all
-from landing_gear_sim.diagnose import diagnose
-from landing_gear_sim.parameters import RigParameters, load_parameters
+from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
+from landing_gear_sim.diagnosis.catalogue import simulate_all
+from landing_gear_sim.diagnosis.diagnose import diagnose
+from landing_gear_sim.model.parameters import RigParameters, load_parameters
 from msg_tools.io import read_campaign
 from msg_tools.run import Run
 

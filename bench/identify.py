@@ -16,10 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
-from landing_gear_sim.campaign import DEVIATING, generate_campaign, rig_like
-from landing_gear_sim.identify import identify
-from landing_gear_sim.parameters import load_parameters
-from landing_gear_sim.validate import validate
+from landing_gear_sim.calibration.campaign import DEVIATING, generate_campaign, rig_like
+from landing_gear_sim.calibration.identify import identify
+from landing_gear_sim.calibration.validate import validate
+from landing_gear_sim.model.parameters import load_parameters
 from msg_tools.io import read_campaign
 
 TARGET_S = 60.0

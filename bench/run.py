@@ -14,10 +14,10 @@ import tracemalloc
 
 import numpy as np
 
-from landing_gear_sim import scenario as sc
-from landing_gear_sim.integrate import simulate, simulate_batch
-from landing_gear_sim.parameters import load_parameters
-from landing_gear_sim.reference import reference_solution
+from landing_gear_sim.model import scenario as sc
+from landing_gear_sim.model.integrate import simulate, simulate_batch
+from landing_gear_sim.model.parameters import load_parameters
+from landing_gear_sim.model.reference import reference_solution
 
 TARGET_RMS_PCT = 0.1  # wheel-speed RMS error, % of initial wheel speed
 TARGET_RUN_S = 0.030  # one 15 s braking run at 1 kHz

@@ -1,6 +1,6 @@
 """landing_gear_sim: digital twin of an aircraft landing-gear anti-skid test rig.
 
-The physics and analysis here never import ROS; ``landing_gear_sim.nodes`` holds
+The physics and analysis here never import ROS; ``landing_gear_sim.ros.nodes`` holds
 the thin rclpy adapters.
 """
 

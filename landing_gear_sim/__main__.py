@@ -2,6 +2,6 @@
 
 import sys
 
-from .cli import main
+from landing_gear_sim.cli import main
 
 sys.exit(main())

@@ -16,20 +16,24 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.model import scenario as sc
+from landing_gear_sim.model.parameters import (
+    ELEMENTS,
+    SPECS,
+    RigParameters,
+    load_parameters,
+    parse_assignment,
+)
+from landing_gear_sim.model.runspec import PROFILES, RunSpec, build_scenario
 from msg_tools.csv_io import Mapping
 from msg_tools.errors import RunFormatError
 
-from . import scenario as sc
-from .errors import LandingGearSimError
-from .parameters import ELEMENTS, SPECS, RigParameters, load_parameters, parse_assignment
-from .runspec import PROFILES, RunSpec, build_scenario
-
 if TYPE_CHECKING:
     from antiskid.metrics import BrakingMetrics
+    from landing_gear_sim.diagnosis.diagnose import Diagnosis
+    from landing_gear_sim.model.integrate import SimulationResult
     from msg_tools.run import Run
-
-    from .diagnose import Diagnosis
-    from .integrate import SimulationResult
 
 PROG = "landing-gear-sim"
 
@@ -97,11 +101,10 @@ def _summary(result: SimulationResult) -> str:
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
+    from landing_gear_sim.model.integrate import simulate
+    from landing_gear_sim.report.figures import plot_simulation
     from msg_tools.bag_io import write_bag
     from msg_tools.csv_io import write_csv
-
-    from .integrate import simulate
-    from .plotting import plot_simulation
 
     if args.bag and args.bag.exists():  # fail before anything is written
         raise LandingGearSimError(f"{args.bag}: exists already; remove it or choose another --bag")
@@ -128,8 +131,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def cmd_rig(args: argparse.Namespace) -> int:
-    from .graph import GraphOptions, controlled_run
-    from .launcher import run_graph
+    from landing_gear_sim.ros.graph import GraphOptions, controlled_run
+    from landing_gear_sim.ros.launcher import run_graph
 
     params = _params(args)
     spec = _run_spec(args)
@@ -235,8 +238,9 @@ def _write_braking_outputs(args: argparse.Namespace, run: Run, rig: RigParameter
                            metrics: BrakingMetrics, default_plot: Path | None = None) -> None:
     import json
 
-    from antiskid.metrics import slip_from, speeds_m_s
     from antiskid.plotting import plot_braking
+
+    from antiskid.metrics import slip_from, speeds_m_s
 
     if args.json:
         args.json.parent.mkdir(parents=True, exist_ok=True)
@@ -250,8 +254,8 @@ def _write_braking_outputs(args: argparse.Namespace, run: Run, rig: RigParameter
 
 
 def cmd_bode(args: argparse.Namespace) -> int:
-    from .linear import frequency_response, resonance_hz
-    from .plotting import plot_bode
+    from landing_gear_sim.model.linear import frequency_response, resonance_hz
+    from landing_gear_sim.report.figures import plot_bode
 
     params = _params(args)
     frequencies = np.logspace(np.log10(args.fmin), np.log10(args.fmax), 800)
@@ -296,10 +300,9 @@ def _write_atomically(path: Path, write: Callable[[Path], None]) -> None:
 def cmd_identify(args: argparse.Namespace) -> int:
     import json
 
+    from landing_gear_sim.calibration.identify import identify
+    from landing_gear_sim.report.validation import estimates_table, text_table
     from msg_tools.io import read_campaign
-
-    from .identify import identify
-    from .report import estimates_table, text_table
 
     campaign = read_campaign(args.campaign, _mapping(args))
     for problem in campaign.problems:
@@ -329,10 +332,9 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
-    from msg_tools.io import read_campaign
-
-    from .identify import _braking, friction_samples
-    from .report import (
+    from landing_gear_sim.calibration.identify import _braking, friction_samples
+    from landing_gear_sim.calibration.validate import CHANNELS, validate
+    from landing_gear_sim.report.validation import (
         html_image,
         html_table,
         plot_friction,
@@ -341,7 +343,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
         text_table,
         write_html,
     )
-    from .validate import CHANNELS, validate
+    from msg_tools.io import read_campaign
 
     campaign = read_campaign(args.campaign, _mapping(args))
     params = _params(args)
@@ -367,10 +369,9 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
+    from landing_gear_sim.calibration.validate import compare
+    from landing_gear_sim.report.validation import plot_overlay, text_table
     from msg_tools.io import read_run
-
-    from .report import plot_overlay, text_table
-    from .validate import compare
 
     measured, simulated = read_run(args.measured, _mapping(args)), read_run(args.simulated)
     comparison = compare(measured, simulated)
@@ -382,7 +383,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 
 def cmd_campaign(args: argparse.Namespace) -> int:
-    from .campaign import GENERATING_FILE, generate_campaign, rig_like
+    from landing_gear_sim.calibration.campaign import GENERATING_FILE, generate_campaign, rig_like
 
     if args.output.exists() and any(args.output.iterdir()):
         raise LandingGearSimError(f"{args.output}: exists and is not empty, not overwriting")
@@ -414,9 +415,8 @@ def cmd_convert(args: argparse.Namespace) -> int:
 def cmd_diagnose(args: argparse.Namespace) -> int:
     import json
 
+    from landing_gear_sim.diagnosis.diagnose import diagnose
     from msg_tools.io import read_runs
-
-    from .diagnose import diagnose
 
     campaign = read_runs(args.runs, _mapping(args))
     for problem in campaign.problems:
@@ -442,7 +442,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
 
 
 def _diagnosis_summary(result: Diagnosis) -> str:
-    from .report import text_table
+    from landing_gear_sim.report.validation import text_table
 
     def fits(values: dict[str, float]) -> str:
         return ", ".join(f"{c.split('_')[0]} {v:.1f}" for c, v in values.items())
@@ -473,8 +473,8 @@ def _maybe(value: float | None) -> str:
 
 
 def _diagnosis_report(result: Diagnosis, runs: Sequence[Run], folder: Path) -> Path:
-    from .diagnose import report_sections
-    from .report import write_html
+    from landing_gear_sim.diagnosis.diagnose import report_sections
+    from landing_gear_sim.report.validation import write_html
 
     sections = report_sections(result, runs, folder)
     return write_html(folder / "index.html", f"Diagnosis: {result.verdict}", sections)
@@ -607,7 +607,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _version() -> str:
-    from . import __version__
+    from landing_gear_sim import __version__
 
     return __version__
 

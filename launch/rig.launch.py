@@ -1,7 +1,7 @@
 """``ros2 launch landing_gear_sim rig.launch.py [profile:=osc-low] [clock:=realtime] ...``
 
 Thin on purpose: the nodes, their parameters and links come from
-``landing_gear_sim.graph.describe``, the same description ``landing-gear-sim rig``
+``landing_gear_sim.ros.graph.describe``, the same description ``landing-gear-sim rig``
 starts without a ROS install. Arguments: see ``graph.LAUNCH_ARGUMENTS``.
 """
 
@@ -10,8 +10,8 @@ from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
-from landing_gear_sim.graph import LAUNCH_ARGUMENTS, PACKAGE, describe, options_from_arguments
-from landing_gear_sim.launcher import ros_environment
+from landing_gear_sim.ros.graph import LAUNCH_ARGUMENTS, PACKAGE, describe, options_from_arguments
+from landing_gear_sim.ros.launcher import ros_environment
 
 
 def _nodes(context):

@@ -11,7 +11,7 @@ os.environ["ROS_DOMAIN_ID"] = str(1 + os.getpid() % 100)
 
 import pytest
 
-from landing_gear_sim.parameters import RigParameters, load_parameters
+from landing_gear_sim.model.parameters import RigParameters, load_parameters
 
 
 @pytest.fixture(scope="session")

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from landing_gear_sim.campaign import generate_campaign, rig_like
-from landing_gear_sim.catalogue import CATALOGUE, fit_candidate, gear_walk_key_parameters
-from landing_gear_sim.identify import identify
+from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
+from landing_gear_sim.calibration.identify import identify
+from landing_gear_sim.diagnosis.catalogue import CATALOGUE, fit_candidate, gear_walk_key_parameters
 from msg_tools.io import read_campaign
 
 ACTUATOR_RUNS = ("actuator_ramp", "actuator_steps_sweep")

@@ -10,10 +10,10 @@ import math
 import numpy as np
 import pytest
 
-from landing_gear_sim.campaign import generate_campaign, rig_like
-from landing_gear_sim.catalogue import CATALOGUE, gear_walk_key_parameters
+from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.cli import main
-from landing_gear_sim.diagnose import DiagnosisError, diagnose, split_runs
+from landing_gear_sim.diagnosis.catalogue import CATALOGUE, gear_walk_key_parameters
+from landing_gear_sim.diagnosis.diagnose import DiagnosisError, diagnose, split_runs
 from msg_tools.csv_io import read_csv, write_csv
 from msg_tools.io import read_campaign
 

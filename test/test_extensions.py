@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from landing_gear_sim import scenario as sc
 from landing_gear_sim.errors import ParameterError
-from landing_gear_sim.integrate import simulate
+from landing_gear_sim.model import scenario as sc
+from landing_gear_sim.model.integrate import simulate
 
 
 def _actuator_run(params, rate_hz: float = 1000.0):
@@ -119,7 +119,7 @@ def test_fade_fraction_below_one(reference):
 
 @pytest.mark.parametrize("extension", [RELAXED, FADING])
 def test_extensions_match_the_tight_radau_reference(reference, extension):
-    from landing_gear_sim.reference import reference_solution
+    from landing_gear_sim.model.reference import reference_solution
 
     extended = reference.replace(extension)
     scenario = sc.rig_test(extended, sc.oscillating(**sc.OSC_LOW))

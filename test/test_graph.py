@@ -12,9 +12,11 @@ import pytest
 import yaml
 from rosbags.rosbag2 import Reader
 
-from landing_gear_sim.blocks import ActuatorBlock, LoadingBlock, PlantBlock
 from landing_gear_sim.errors import LandingGearSimError
-from landing_gear_sim.graph import (
+from landing_gear_sim.model.blocks import ActuatorBlock, LoadingBlock, PlantBlock
+from landing_gear_sim.model.integrate import simulate
+from landing_gear_sim.model.runspec import RunSpec, build_scenario
+from landing_gear_sim.ros.graph import (
     LAUNCH_ARGUMENTS,
     RECORDED_TOPICS,
     TOPIC_CLOCK,
@@ -23,9 +25,7 @@ from landing_gear_sim.graph import (
     describe,
     options_from_arguments,
 )
-from landing_gear_sim.integrate import simulate
-from landing_gear_sim.launcher import format_value, node_command, ros_environment
-from landing_gear_sim.runspec import RunSpec, build_scenario
+from landing_gear_sim.ros.launcher import format_value, node_command, ros_environment
 from msg_tools.bag_io import TYPESTORE, read_bag
 from msg_tools.bag_segments import OPEN_SEGMENT, SegmentedBagWriter
 from msg_tools.contract import ATMOSPHERE_PA, TOPIC_TYPES
@@ -112,7 +112,7 @@ def test_parameter_values_are_written_as_ros_reads_them(value, text):
 def test_node_command_runs_the_module_with_the_params_file(tmp_path):
     plant = describe(GraphOptions())[0]
     command = node_command(plant, tmp_path / "p.yaml", "python")
-    assert command[:4] == ["python", "-m", "landing_gear_sim.nodes.plant", "--ros-args"]
+    assert command[:4] == ["python", "-m", "landing_gear_sim.ros.nodes.plant", "--ros-args"]
     assert command[4:6] == ["--params-file", str(tmp_path / "p.yaml")]
     assert "clock:='lockstep'" in command
 

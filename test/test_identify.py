@@ -8,11 +8,11 @@ import shutil
 import numpy as np
 import pytest
 
-from landing_gear_sim.campaign import DEVIATING, generate_campaign, rig_like
+from landing_gear_sim.calibration.campaign import DEVIATING, generate_campaign, rig_like
+from landing_gear_sim.calibration.identify import classify, identify
+from landing_gear_sim.calibration.validate import fit_percent, simulate_run, validate
 from landing_gear_sim.cli import main
-from landing_gear_sim.identify import classify, identify
-from landing_gear_sim.parameters import load_parameters
-from landing_gear_sim.validate import fit_percent, simulate_run, validate
+from landing_gear_sim.model.parameters import load_parameters
 from msg_tools.io import read_campaign
 
 SEED = 11  # the hidden rig: datasheet values off by up to ±3 %, never shown to identify()

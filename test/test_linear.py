@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from landing_gear_sim.linear import (
+from landing_gear_sim.model.linear import (
     frequency_response,
     linearise,
     operating_point,

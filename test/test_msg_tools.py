@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from landing_gear_sim import scenario as sc
-from landing_gear_sim.integrate import simulate
+from landing_gear_sim.model import scenario as sc
+from landing_gear_sim.model.integrate import simulate
 from msg_tools.bag_io import read_bag, write_bag
 from msg_tools.contract import CSV_COLUMNS
 from msg_tools.csv_io import read_csv, write_csv

@@ -13,10 +13,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from landing_gear_sim.integrate import simulate
-from landing_gear_sim.launcher import ros_environment
-from landing_gear_sim.parameters import load_parameters
-from landing_gear_sim.runspec import RunSpec, build_scenario
+from landing_gear_sim.model.integrate import simulate
+from landing_gear_sim.model.parameters import load_parameters
+from landing_gear_sim.model.runspec import RunSpec, build_scenario
+from landing_gear_sim.ros.launcher import ros_environment
 from msg_tools.bag_io import read_bag
 from msg_tools.csv_io import format_csv, write_csv
 
@@ -162,10 +162,10 @@ def test_replay_publishes_a_run_that_the_recorder_writes_back(tmp_path, referenc
     bag = tmp_path / "bag"
     env = ros_environment()
     node = [sys.executable, "-m"]
-    recorder = subprocess.Popen([*node, "landing_gear_sim.nodes.recorder", "--ros-args", "-p",
+    recorder = subprocess.Popen([*node, "landing_gear_sim.ros.nodes.recorder", "--ros-args", "-p",
                                  f"bag:={bag}"], env=env, stderr=subprocess.PIPE, text=True)
     try:
-        replay = _run([*node, "landing_gear_sim.nodes.replay", "--ros-args", "-p",
+        replay = _run([*node, "landing_gear_sim.ros.nodes.replay", "--ros-args", "-p",
                        f"file:={tmp_path / 'run.csv'}", "-p", "speed:=5.0",
                        "-p", "wait_for_subscribers:=1"])
         assert replay.returncode == 0, replay.stderr[-2000:]
@@ -204,7 +204,7 @@ def _bad_files(folder: Path) -> dict[str, tuple[Path, str]]:
 
 def test_replay_of_a_bad_file_is_one_error_line_and_exit_2(tmp_path):
     for name, (path, fragment) in _bad_files(tmp_path).items():
-        done = _run([sys.executable, "-m", "landing_gear_sim.nodes.replay", "--ros-args", "-p",
+        done = _run([sys.executable, "-m", "landing_gear_sim.ros.nodes.replay", "--ros-args", "-p",
                      f"file:={path}"], timeout=60)
         lines = done.stderr.strip().splitlines()
         assert done.returncode == 2, (name, done.stderr)

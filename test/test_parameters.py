@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 from landing_gear_sim.errors import ParameterError
-from landing_gear_sim.parameters import (
+from landing_gear_sim.model.parameters import (
     INDEX,
     N_PARAMS,
     SPECS,

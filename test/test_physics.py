@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from landing_gear_sim import plant
-from landing_gear_sim import scenario as sc
-from landing_gear_sim.integrate import run_kernel, simulate, simulate_batch
-from landing_gear_sim.parameters import load_parameters
-from landing_gear_sim.reference import reference_solution
+from landing_gear_sim.model import plant
+from landing_gear_sim.model import scenario as sc
+from landing_gear_sim.model.integrate import run_kernel, simulate, simulate_batch
+from landing_gear_sim.model.parameters import load_parameters
+from landing_gear_sim.model.reference import reference_solution
 
 
 @pytest.fixture(scope="module")

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import scipy.signal
 
-from landing_gear_sim import residuals as rs
-from landing_gear_sim import scenario as sc
-from landing_gear_sim.integrate import simulate
+from landing_gear_sim.diagnosis import residuals as rs
+from landing_gear_sim.model import scenario as sc
+from landing_gear_sim.model.integrate import simulate
 
 RATE = 1000.0
 

@@ -8,9 +8,9 @@ import shutil
 import numpy as np
 import pytest
 
-from landing_gear_sim import scenario as sc
 from landing_gear_sim.cli import main
-from landing_gear_sim.integrate import simulate
+from landing_gear_sim.model import scenario as sc
+from landing_gear_sim.model.integrate import simulate
 from msg_tools.bag_io import write_bag
 from msg_tools.csv_io import format_csv, read_csv, read_mapping, write_csv
 from msg_tools.errors import RunFormatError

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from landing_gear_sim import elements as el
-from landing_gear_sim import scenario as sc
 from landing_gear_sim.errors import ScenarioError
+from landing_gear_sim.model import elements as el
+from landing_gear_sim.model import scenario as sc
 
 
 @pytest.mark.parametrize("pressure_bar", [0.0, 5.0, 30.0, 45.0, 60.0])

@@ -1,0 +1,71 @@
+"""The project's own rig generator: a synthetic calibration campaign (documented as synthetic).
+
+It simulates the standard runs of a rig campaign with a parameter set that
+deviates from the datasheet by a few percent, adds sensor noise, and writes the
+runs as contract CSVs. The generating parameters are written beside them for
+tests and benchmarks; identification and diagnosis never read that file.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from landing_gear_sim.model import scenario as sc
+from landing_gear_sim.model.integrate import simulate
+from landing_gear_sim.model.parameters import RigParameters
+from msg_tools.csv_io import write_csv
+
+DEVIATING = ("flywheel.inertia_kg_m2", "drag.coeff_n_s2_per_m2", "friction.theta1",
+             "friction.theta2", "friction.theta3", "brake.gain_n_m_per_pa",
+             "actuator.map_k1_pa_per_a", "actuator.natural_frequency_hz",
+             "actuator.damping_ratio")
+"""Parameters on which a real rig differs from its datasheet."""
+
+NOISE = {"sensors.pressure_noise_pa": 1.5e4, "sensors.speed_noise_rad_s": 0.1,
+         "sensors.force_noise_n": 100.0}
+GENERATING_FILE = "generating-parameters.yaml"
+
+
+def rig_like(datasheet: RigParameters, rng: np.random.Generator,
+             deviation: float = 0.03) -> RigParameters:
+    """A 'real rig': every DEVIATING parameter off by up to ±``deviation`` (uniform)."""
+    changes = {k: datasheet.number(k) * (1 + rng.uniform(-deviation, deviation))
+               for k in DEVIATING}
+    return datasheet.replace({**changes, **NOISE}, "rig generator")
+
+
+def standard_scenarios(p: RigParameters) -> dict[str, sc.Scenario]:
+    """The runs of a calibration campaign (same names as the example campaigns)."""
+    runs: dict[str, Callable[[], sc.Scenario]] = {
+        "actuator_ramp": lambda: sc.actuator_test(
+            p, sc.quasi_static_ramp(p.number("actuator.max_current_a")), 20.0, "actuator_ramp"),
+        "actuator_steps_sweep": lambda: sc.actuator_test(
+            p, sc.steps_then_sweep(), 28.0, "actuator_steps_sweep"),
+        **{f"brake_const_{bar}bar": (lambda bar=bar: sc.constant_pressure_test(p, bar * 1e5))
+           for bar in (10, 20, 30, 40)},
+        "brake_osc_low": lambda: sc.rig_test(p, sc.oscillating(**sc.OSC_LOW), "brake_osc_low"),
+        "brake_osc_high": lambda: sc.rig_test(p, sc.oscillating(**sc.OSC_HIGH),
+                                              "brake_osc_high"),
+    }
+    return {name: build() for name, build in runs.items()}
+
+
+def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,
+                      names: Sequence[str] | None = None) -> list[Path]:
+    """Simulate and write the standard runs of ``rig`` (or those in ``names``) into
+    ``folder``; returns the CSV paths."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    written = []
+    for i, (name, scenario) in enumerate(standard_scenarios(rig).items()):
+        if names is not None and name not in names:
+            continue
+        run = simulate(rig, scenario).to_run(noise_seed=seed * 100 + i)
+        path = folder / f"{name}.csv"
+        write_csv(run, path)
+        written.append(path)
+    rig.to_yaml(folder / GENERATING_FILE)
+    return written

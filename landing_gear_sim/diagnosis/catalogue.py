@@ -1,0 +1,292 @@
+"""The diagnosis catalogue: candidate model extensions and their output-error fit.
+
+Each candidate is a real model element (switched on with ``elements.<name>``) with
+physical parameters. Fitting one means: switch it on, then fit its parameters,
+together with the base parameters it trades off against, by simulating the runs
+that carry its signature with their measured inputs (output error, not one-step
+prediction). Residuals are scaled by each channel's sensor noise, estimated from
+the measurement itself.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from landing_gear_sim.calibration.identify import classify, covariance_std
+from landing_gear_sim.calibration.validate import simulate_run
+from landing_gear_sim.model.parameters import RigParameters
+from msg_tools.run import Run
+
+DECIMATE = 2  # residual samples kept (the simulation itself runs at the full rate)
+START_RATIO = 2.0  # multi-start: optimise only starts this close to the best initial cost
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """A model extension the diagnosis can propose.
+
+    Attributes:
+        cause: name in the diagnosis contract.
+        element: the ``elements.<name>`` switch it turns on (None: the friction curve,
+            which every model has; the candidate frees its parameters).
+        keys: its own parameters, fitted.
+        starts: start values tried for ``keys`` (multi-start: lags and frequencies
+            have local minima); empty: start from the model's current values.
+        bounds: admissible range of each key.
+        free: base-model parameters re-fitted with it (they could otherwise absorb
+            or mask the effect).
+        runs: run kinds that carry its signature, fitted on: families ("actuator",
+            "brake") or classes ("brake_constant"; when the campaign has none, their
+            family).
+        channels: measured channels compared.
+        held_out: run kinds that also show the effect and are kept to check it (when
+            empty, the fitting runs are split in two).
+        contract: key parameter names of the diagnosis contract -> parameter keys.
+    """
+
+    cause: str
+    element: str | None
+    keys: tuple[str, ...]
+    starts: tuple[tuple[float, ...], ...]
+    bounds: tuple[tuple[float, float], ...]
+    free: tuple[str, ...]
+    runs: tuple[str, ...]
+    channels: tuple[str, ...]
+    held_out: tuple[str, ...]
+    contract: tuple[tuple[str, str], ...]
+
+
+ACTUATOR = ("actuator.natural_frequency_hz", "actuator.damping_ratio")
+FRICTION = ("friction.theta1", "friction.theta2", "friction.theta3")
+STATIC_MAP = ("actuator.deadband_current_a", "actuator.map_k1_pa_per_a",
+              "actuator.map_k2_pa_per_a2", "actuator.max_pressure_pa")
+GEAR_WALK = ("gear_walk.stiffness_n_m_per_rad", "gear_walk.damping_n_m_s_per_rad")
+PRESSURE = ("pressure_pa",)
+WHEEL = ("wheel_speed_rad_s", "longitudinal_force_n")
+FADE = ("brake.fade_fraction", "brake.fade_energy_j")
+
+CATALOGUE: dict[str, Candidate] = {c.cause: c for c in (
+    # an actuator effect shows in every run's pressure: fitted on the actuator runs,
+    # checked on the braking runs' pressure
+    Candidate("actuator_delay", "actuator_delay", ("actuator.delay_s",),
+              ((0.002,), (0.006,), (0.012,), (0.025,)), ((0.0, 0.06),), ACTUATOR,
+              ("actuator",), PRESSURE, ("brake",), (("delay_s", "actuator.delay_s"),)),
+    # an offset shifts the whole map while calibrating it: re-fit the map with it; the
+    # stretches below the dead-band tell the two apart
+    Candidate("pressure_sensor_offset", "pressure_sensor_offset",
+              ("sensors.pressure_offset_pa",), ((0.0,),), ((-10e5, 10e5),), STATIC_MAP,
+              ("actuator",), PRESSURE, ("brake",),
+              (("offset_pa", "sensors.pressure_offset_pa"),)),
+    Candidate("actuator_dynamics", "actuator_dynamics", ACTUATOR,
+              ((8.0, 0.5), (15.0, 0.8)), ((1.0, 60.0), (0.1, 2.0)), (), ("actuator",),
+              PRESSURE, ("brake",), (("natural_frequency_hz", ACTUATOR[0]),
+                                     ("damping_ratio", ACTUATOR[1]))),
+    # fitted on the constant-pressure stops: in the oscillating runs the wheel nears the
+    # skid and the output error jumps with the exact moment (a fit there got stuck at
+    # 2/3 of the true length, in a valley of width ~1 %)
+    Candidate("tire_relaxation", "tire_relaxation", ("tyre.relaxation_length_m",),
+              ((0.1,), (0.4,), (1.0,)), ((0.005, 5.0),), FRICTION, ("brake_constant",), WHEEL,
+              (),
+              (("relaxation_length_m", "tyre.relaxation_length_m"),)),
+    Candidate("gear_walk", "gear_walk", GEAR_WALK,
+              ((6.9e5, 1372.0), (3e5, 1000.0), (1.5e6, 2000.0)),
+              ((5e4, 2e7), (10.0, 5e4)), FRICTION, ("brake",), WHEEL, (), ()),
+    Candidate("brake_fade", "brake_fade", FADE, ((0.1, 2e6), (0.3, 5e5)),
+              # the calibration bent the friction curve to absorb the fade: free it too
+              ((0.0, 0.9), (1e4, 1e8)), ("brake.gain_n_m_per_pa", *FRICTION), ("brake",),
+              # the measured force is the brake torque over r whatever the friction
+              # curve (which the calibration distorted to absorb the fade)
+              ("longitudinal_force_n", "flywheel_speed_rad_s"), (),
+              (("fade_fraction", FADE[0]), ("fade_energy_j", FADE[1]),
+               ("gain_n_m_per_pa", "brake.gain_n_m_per_pa"))),
+    Candidate("drag", "drag", ("drag.coeff_n_s2_per_m2",), ((0.2,),), ((0.0, 5.0),),
+              ("flywheel.inertia_kg_m2",), ("brake",), ("flywheel_speed_rad_s",), (),
+              (("drag_coeff_n_s2_per_m2", "drag.coeff_n_s2_per_m2"),)),
+    Candidate("load_dependent_radius", "load_dependent_radius",
+              ("radius.a_m_per_n2", "radius.b_m_per_n"), ((4e-12, 5e-7),),
+              # without the element the calibration bent the friction curve (slip read
+              # with one radius at every load): free it too
+              ((0.0, 1e-10), (0.0, 5e-6)),
+              ("wheel.unloaded_radius_m", "brake.gain_n_m_per_pa", *FRICTION), ("brake",),
+              WHEEL, (),
+              (("radius_a_m_per_n2", "radius.a_m_per_n2"),
+               ("radius_b_m_per_n", "radius.b_m_per_n"))),
+    Candidate("friction_curve", None, FRICTION, (), ((0.05, 3.0), (1.0, 300.0), (0.0, 2.0)),
+              (), ("brake",), WHEEL, (), tuple((k.split(".")[1], k) for k in FRICTION)),
+)}
+
+
+@dataclass(frozen=True)
+class CandidateFit:
+    """A fitted candidate (or its null: the same free parameters without it): the
+    parameter set, values and 1-σ of what was fitted, and the scaled residual."""
+
+    candidate: Candidate
+    params: RigParameters
+    values: dict[str, float]
+    std: dict[str, float]
+    residual: np.ndarray
+
+    @property
+    def cost(self) -> float:
+        """Sum of squared noise-scaled residuals."""
+        return float(self.residual @ self.residual)
+
+
+Scales = dict[tuple[str, str], float]
+
+
+def noise_std(values: np.ndarray) -> float:
+    """Sensor-noise std of a 1 kHz channel: first differences are noise-dominated."""
+    return float(np.std(np.diff(values)) / math.sqrt(2)) or 1.0
+
+
+def noise_scales(runs: Sequence[Run], channels: Sequence[str]) -> Scales:
+    """Noise std of every (run, channel), estimated from the measurement itself."""
+    return {(r.name, c): noise_std(getattr(r, c)) for r in runs for c in channels}
+
+
+def select_runs(runs: Sequence[Run], kinds: Sequence[str]) -> list[Run]:
+    """Runs of one of ``kinds``: a family ("actuator", "brake") or a class
+    ("brake_constant", see identify.classify)."""
+    classes = [classify(r) for r in runs]  # classify reads the signals: once per run
+    return [r for r, c in zip(runs, classes, strict=True)
+            if c in kinds or c.split("_")[0] in kinds]
+
+
+def simulate_all(runs: Sequence[Run], params: RigParameters) -> list[Run]:
+    """Every run simulated with its measured input, on its own time base."""
+    return [simulate_run(run, params)[0] for run in runs]
+
+
+def scaled_error(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequence[str],
+                 scales: Scales) -> np.ndarray:
+    """Simulation minus measurement over ``channels``, divided by the noise, decimated."""
+    return np.concatenate([(getattr(sim, c) - getattr(run, c))[::DECIMATE]
+                           / scales[(run.name, c)]
+                           for run, sim in zip(runs, simulated, strict=True) for c in channels])
+
+
+def scaled_residual(runs: Sequence[Run], params: RigParameters, channels: Sequence[str],
+                    scales: Scales) -> np.ndarray:
+    """Simulation minus measurement over ``channels`` of ``runs``, divided by the noise."""
+    return scaled_error(runs, simulate_all(runs, params), channels, scales)
+
+
+def switched_on(candidate: Candidate, params: RigParameters) -> RigParameters:
+    """``params`` with the candidate's element on, its keys at their first start values."""
+    if candidate.element is None:
+        return params
+    starts = dict(zip(candidate.keys, candidate.starts[0], strict=True)) if candidate.starts \
+        else {}
+    return params.replace({f"elements.{candidate.element}": True, **starts},
+                          f"candidate {candidate.cause}")
+
+
+def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters,
+                  datasheet: RigParameters | None = None, *, null: bool = False,
+                  tries: int = 2, scales: Scales | None = None) -> CandidateFit:
+    """Switch ``candidate`` on in ``base`` and fit its keys plus its free base parameters
+    on the runs of its kinds among ``runs``.
+
+    ``base`` is the model calibrated without the candidate; where the missing element
+    distorted that calibration, the free parameters are also started from
+    ``datasheet`` (the design values), and their window spans both. Of all start
+    points, the ``tries`` with the lowest initial cost are optimised, those that start
+    within ``START_RATIO`` of the best (a start further off ended no
+    better in any campaign tried, and each optimisation costs seconds). ``null=True``
+    fits the free parameters alone, element off: the fair reference for the candidate.
+    """
+    chosen = select_runs(runs, candidate.runs)
+    if not chosen:
+        raise ValueError(f"{candidate.cause}: no {'/'.join(candidate.runs)} run to fit on")
+    scales = scales or noise_scales(chosen, candidate.channels)
+    own = () if null else candidate.keys
+    model = base if null else switched_on(candidate, base)
+    free = [k for k in candidate.free if k not in candidate.keys]
+    references = [base] + ([datasheet] if datasheet is not None else [])
+    keys = [*own, *free]
+    if not keys:
+        residual = scaled_residual(chosen, model, candidate.channels, scales)
+        return CandidateFit(candidate, model, {}, {}, residual)
+    own_bounds = candidate.bounds if own else ()
+    lower = np.array([b[0] for b in own_bounds]
+                     + [0.5 * min(r.number(k) for r in references) for k in free])
+    upper = np.array([b[1] for b in own_bounds]
+                     + [2.0 * max(r.number(k) for r in references) for k in free])
+    window = _Window(lower, upper)
+
+    def residual(u: np.ndarray) -> np.ndarray:
+        trial = model.replace(dict(zip(keys, window.value(u), strict=True)), "fit")
+        return scaled_residual(chosen, trial, candidate.channels, scales)
+
+    own_starts = candidate.starts if own and candidate.starts else [()]
+    points = [window.unit(np.array([*(s or [r.number(k) for k in own]),
+                                    *(r.number(k) for k in free)]))
+              for s in own_starts for r in references]
+    initial = [float(np.sum(residual(u) ** 2)) for u in points]
+    best = None
+    for i in np.argsort(initial)[:tries]:
+        if initial[i] > START_RATIO * min(initial):
+            break
+        fit = least_squares(residual, points[i], bounds=(0.0, 1.0), x_scale=0.01,
+                            diff_step=1e-4)
+        if best is None or fit.cost < best.cost:
+            best = fit
+    assert best is not None
+    values = window.value(best.x)
+    std = covariance_std(best, len(keys)) * window.slope(best.x)
+    fitted = model.replace(dict(zip(keys, values, strict=True)), f"fit {candidate.cause}")
+    return CandidateFit(candidate, fitted, dict(zip(keys, map(float, values), strict=True)),
+                        dict(zip(keys, map(float, std), strict=True)), best.fun)
+
+
+@dataclass(frozen=True)
+class _Window:
+    """Maps the optimiser's unit box to parameter values: logarithmic for positive
+    ranges spanning more than a decade (energies, stiffnesses), linear otherwise."""
+
+    lower: np.ndarray
+    upper: np.ndarray
+
+    @property
+    def log(self) -> np.ndarray:
+        return (self.lower > 0) & (self.upper > 10 * self.lower)
+
+    def value(self, u: np.ndarray) -> np.ndarray:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            geometric = self.lower * (self.upper / self.lower) ** u
+        return np.where(self.log, geometric, self.lower + u * (self.upper - self.lower))
+
+    def unit(self, value: np.ndarray) -> np.ndarray:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            geometric = np.log(value / self.lower) / np.log(self.upper / self.lower)
+        u = np.where(self.log, geometric, (value - self.lower) / (self.upper - self.lower))
+        return np.clip(u, 1e-6, 1 - 1e-6)
+
+    def slope(self, u: np.ndarray) -> np.ndarray:
+        """d value / d u (turns a σ of u into a σ of the value)."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            geometric = self.value(u) * np.log(self.upper / self.lower)
+        return np.where(self.log, geometric, self.upper - self.lower)
+
+
+def key_parameters(candidate: Candidate, params: RigParameters) -> dict[str, float]:
+    """The candidate's key parameters under their contract names, SI."""
+    if candidate.cause == "gear_walk":
+        return gear_walk_key_parameters(params)
+    return {name: params.number(key) for name, key in candidate.contract}
+
+
+def gear_walk_key_parameters(params: RigParameters) -> dict[str, float]:
+    """frequency_hz = √(k_θ/J)/2π and damping_ratio = c_θ/(2√(k_θ J)), gear alone."""
+    k = params.number("gear_walk.stiffness_n_m_per_rad")
+    j = params.number("gear_walk.inertia_kg_m2")
+    c = params.number("gear_walk.damping_n_m_s_per_rad")
+    return {"frequency_hz": math.sqrt(k / j) / (2 * math.pi),
+            "damping_ratio": c / (2 * math.sqrt(k * j))}

@@ -1,0 +1,167 @@
+"""Model elements: one physical law each, compiled with numba.
+
+Every function takes the packed parameter vector ``p`` (see
+:mod:`landing_gear_sim.model.parameters`) and SI quantities, and is pure. The plant
+(:mod:`landing_gear_sim.model.plant`) composes them; a switchable element is skipped
+when its ``elements.<name>`` flag is 0. Equation numbers refer to the paper.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from landing_gear_sim.model.parameters import INDEX
+
+GRAVITY_M_S2 = 9.80665
+MIN_HUB_SPEED_M_S = 0.05  # slip is undefined at rest; the stop rule keeps runs above this
+
+# Positions in the packed vector; numba freezes module globals as constants.
+CONFIGURATION = INDEX["configuration"]
+HAS_GEAR_WALK = INDEX["elements.gear_walk"]
+HAS_RADIUS = INDEX["elements.load_dependent_radius"]
+HAS_ACTUATOR_DYNAMICS = INDEX["elements.actuator_dynamics"]
+HAS_DRAG = INDEX["elements.drag"]
+HAS_ACTUATOR_DELAY = INDEX["elements.actuator_delay"]
+HAS_RELAXATION = INDEX["elements.tire_relaxation"]
+HAS_FADE = INDEX["elements.brake_fade"]
+RELAXATION = INDEX["tyre.relaxation_length_m"]
+FADE_FRACTION = INDEX["brake.fade_fraction"]
+FADE_ENERGY = INDEX["brake.fade_energy_j"]
+FLY_RADIUS = INDEX["flywheel.radius_m"]
+FLY_INERTIA = INDEX["flywheel.inertia_kg_m2"]
+DRAG = INDEX["drag.coeff_n_s2_per_m2"]
+R0 = INDEX["wheel.unloaded_radius_m"]
+WHEEL_INERTIA = INDEX["wheel.inertia_kg_m2"]
+RADIUS_A = INDEX["radius.a_m_per_n2"]
+RADIUS_B = INDEX["radius.b_m_per_n"]
+RADIUS_C = INDEX["radius.c_m"]
+THETA1 = INDEX["friction.theta1"]
+THETA2 = INDEX["friction.theta2"]
+THETA3 = INDEX["friction.theta3"]
+GW_LENGTH = INDEX["gear_walk.length_m"]
+GW_INERTIA = INDEX["gear_walk.inertia_kg_m2"]
+GW_STIFFNESS = INDEX["gear_walk.stiffness_n_m_per_rad"]
+GW_DAMPING = INDEX["gear_walk.damping_n_m_s_per_rad"]
+AC_MASS = INDEX["aircraft.mass_kg"]
+AC_WHEEL_MASS = INDEX["aircraft.wheel_mass_kg"]
+AC_GEAR_MASS = INDEX["aircraft.gear_mass_kg"]
+BRAKE_GAIN = INDEX["brake.gain_n_m_per_pa"]
+MAX_CURRENT = INDEX["actuator.max_current_a"]
+DEADBAND = INDEX["actuator.deadband_current_a"]
+MAP_K1 = INDEX["actuator.map_k1_pa_per_a"]
+MAP_K2 = INDEX["actuator.map_k2_pa_per_a2"]
+MAX_PRESSURE = INDEX["actuator.max_pressure_pa"]
+LOAD_STATIC = INDEX["loading.static_load_n"]
+LIFT = INDEX["loading.lift_coeff_n_s2_per_m2"]
+LOAD_TAU = INDEX["loading.servo_time_constant_s"]
+TOUCHDOWN_RAMP = INDEX["loading.touchdown_ramp_s"]
+TOUCHDOWN_T = INDEX["rig_test.touchdown_s"]
+
+
+@njit(cache=True)
+def burckhardt(p, slip):
+    """Friction coefficient μ(λ), eq. (11), extended odd for λ < 0 (wheel faster than hub)."""
+    s = abs(slip)
+    mu = p[THETA1] * (1.0 - math.exp(-p[THETA2] * s)) - p[THETA3] * s
+    return mu if slip >= 0.0 else -mu
+
+
+@njit(cache=True)
+def burckhardt_slope_max(p):
+    """Largest |dμ/dλ| of the curve (at λ = 0): the tyre's stiffest point."""
+    return p[THETA1] * p[THETA2] + p[THETA3]
+
+
+@njit(cache=True)
+def rolling_radius(p, vertical_load_n):
+    """Rolling radius r = r0 − (a F_z² + b F_z + c), eq. (9); r0 when the element is off."""
+    if p[HAS_RADIUS] == 0.0:
+        return p[R0]
+    fz = vertical_load_n
+    return p[R0] - (p[RADIUS_A] * fz * fz + p[RADIUS_B] * fz + p[RADIUS_C])
+
+
+@njit(cache=True)
+def slip_ratio(hub_speed_m_s, wheel_speed_rad_s, radius_m):
+    """Longitudinal slip λ = (v_h − ω r)/v_h, eq. (1)."""
+    vh = max(hub_speed_m_s, MIN_HUB_SPEED_M_S)
+    return (vh - wheel_speed_rad_s * radius_m) / vh
+
+
+@njit(cache=True)
+def brake_torque(p, pressure_pa, brake_energy_j):
+    """Brake torque T_b = k_b P_b, eq. (8); a brake cannot push, so P_b < 0 gives 0.
+
+    With ``brake_fade`` the gain falls as the brake heats:
+    k_b (1 − φ (1 − e^{−E/E_f})), E the energy the brake has absorbed.
+    """
+    gain = p[BRAKE_GAIN]
+    if p[HAS_FADE]:
+        gain *= 1.0 - p[FADE_FRACTION] * (1.0 - math.exp(-brake_energy_j / p[FADE_ENERGY]))
+    return gain * max(pressure_pa, 0.0)
+
+
+@njit(cache=True)
+def relaxation_rate(p, hub_speed_m_s):
+    """1/τ of the tyre force lag, v_h/σ (0 when the element is off)."""
+    if p[HAS_RELAXATION] == 0.0:
+        return 0.0
+    return max(hub_speed_m_s, MIN_HUB_SPEED_M_S) / p[RELAXATION]
+
+
+@njit(cache=True)
+def drag_force(p, speed_m_s):
+    """Drag α_d v² (flywheel bearing/windage on the rig, aerodynamic on the aircraft)."""
+    if p[HAS_DRAG] == 0.0:
+        return 0.0
+    return p[DRAG] * speed_m_s * abs(speed_m_s)
+
+
+@njit(cache=True)
+def wheel_acceleration(p, wheel_speed_rad_s, radius_m, tyre_force_n, brake_torque_n_m):
+    """ω̇ from eq. (7), with lock: a stopped wheel stays stopped while the brake holds it."""
+    net = radius_m * tyre_force_n - brake_torque_n_m
+    if wheel_speed_rad_s <= 0.0 and net <= 0.0:
+        return 0.0
+    return net / p[WHEEL_INERTIA]
+
+
+@njit(cache=True)
+def gear_walk_torque(p, angle_rad, rate_rad_s):
+    """Spring-damper torque c_θ θ̇ + k_θ θ of the gear-walk element, eq. (6)."""
+    return p[GW_DAMPING] * rate_rad_s + p[GW_STIFFNESS] * angle_rad
+
+
+@njit(cache=True)
+def aircraft_coupling(p):
+    """J_θ = L_gw (m_gw/2 + m_w), the gear-walk/aircraft coupling of eqs. (5)-(6)."""
+    return p[GW_LENGTH] * (0.5 * p[AC_GEAR_MASS] + p[AC_WHEEL_MASS])
+
+
+@njit(cache=True)
+def translational_mass(p):
+    """Mass whose speed is v_f (rig: J_f/R_f²) or v_a (aircraft: m_a + m_w + m_gw)."""
+    if p[CONFIGURATION] == 0.0:
+        return p[FLY_INERTIA] / (p[FLY_RADIUS] * p[FLY_RADIUS])
+    return p[AC_MASS] + p[AC_WHEEL_MASS] + p[AC_GEAR_MASS]
+
+
+@njit(cache=True)
+def valve_static_pressure(p, current_a):
+    """Static current→pressure map P = k1 (I−I0) + k2 (I−I0)², dead-band and saturation."""
+    current = min(max(current_a, 0.0), p[MAX_CURRENT])
+    excess = max(current - p[DEADBAND], 0.0)
+    return min(p[MAP_K1] * excess + p[MAP_K2] * excess * excess, p[MAX_PRESSURE])
+
+
+@njit(cache=True)
+def vertical_load_reference(p, time_s, speed_m_s):
+    """Loading-device reference F_z0 − k_L v², ramped in over the touch-down ramp."""
+    elapsed = time_s - p[TOUCHDOWN_T]
+    if elapsed < 0.0:
+        return 0.0
+    ramp = p[TOUCHDOWN_RAMP]
+    scale = 1.0 if ramp <= 0.0 or elapsed >= ramp else elapsed / ramp
+    return scale * max(p[LOAD_STATIC] - p[LIFT] * speed_m_s * speed_m_s, 0.0)

@@ -1,0 +1,183 @@
+"""Run scenarios through the plant: one run, or a batch of parameter sets in one call.
+
+The whole run loop is compiled (numba), calling the same block step functions
+the ROS nodes call one at a time (:mod:`landing_gear_sim.model.plant`), so an offline
+run and a graph run of the same inputs agree to the last bit.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit, prange
+
+from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.plant import (
+    CHANNELS,
+    N_CHANNELS,
+    N_STATES,
+    SPEED,
+    actuator_matrices,
+    actuator_state,
+    actuator_step,
+    loading_step,
+    plant_step,
+    record,
+)
+from landing_gear_sim.model.scenario import Scenario, held_to_logged
+from msg_tools.run import Run
+
+STOP_REASONS = ("end of input", "stop speed reached")
+
+
+@njit(cache=True)
+def run_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed, out):
+    """Simulate one run; fill ``out`` (n, N_CHANNELS); return (rows written, stop code)."""
+    x = np.zeros(N_STATES)
+    x[SPEED] = initial_speed if contact else 0.0
+    xa = actuator_state(matrices)
+    xl = np.zeros(1)
+    work = np.zeros((5, N_STATES))
+    pressure, load = 0.0, 0.0
+    n = current.shape[0]
+    for k in range(n):
+        t = k * step_s
+        record(p, x, t, current[k], pressure, load, out[k])
+        if contact and stop_speed > 0.0 and x[SPEED] < stop_speed:
+            return k + 1, 1
+        if k == n - 1:
+            break
+        next_pressure = actuator_step(p, matrices, xa, current[k])
+        next_load = loading_step(p, xl, t, x[SPEED], step_s) if contact else 0.0
+        plant_step(p, x, pressure, next_pressure, load, next_load, step_s, work)
+        pressure, load = next_pressure, next_load
+    return n, 0
+
+
+@njit(cache=True)
+def actuator_kernel(p, matrices, current, out):
+    """The pressure column ``run_kernel`` records, from the actuator alone (it does not
+    depend on the wheel): ``out[0]`` = 0, ``out[k+1]`` after step k with ``current[k]``."""
+    xa = actuator_state(matrices)
+    out[0] = 0.0
+    for k in range(current.shape[0] - 1):
+        out[k + 1] = actuator_step(p, matrices, xa, current[k])
+
+
+@njit(cache=True, parallel=True)
+def batch_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed, out, rows, stop):
+    """``run_kernel`` over parameter sets ``p`` (m, N_PARAMS) in parallel; inputs (m, n)."""
+    for i in prange(p.shape[0]):
+        rows[i], stop[i] = run_kernel(p[i], matrices[i], current[i], step_s, contact,
+                                      initial_speed, stop_speed, out[i])
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """Sampled signals of one simulated run.
+
+    ``data`` has shape (n, len(CHANNELS)); each channel is also an attribute,
+    e.g. ``result.wheel_speed_rad_s`` (see :data:`landing_gear_sim.model.plant.CHANNELS`).
+    """
+
+    scenario: Scenario
+    params: RigParameters
+    data: np.ndarray
+    stop_reason: str
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        if name in CHANNELS:
+            return self.data[:, CHANNELS.index(name)]
+        raise AttributeError(name)
+
+    def __len__(self) -> int:
+        return int(self.data.shape[0])
+
+    def _pressure_offset_pa(self) -> float:
+        if not self.params.has("pressure_sensor_offset"):
+            return 0.0
+        return self.params.number("sensors.pressure_offset_pa")
+
+    def sensed_pressure_to_end(self) -> np.ndarray:
+        """Brake pressure as the transducer reads it (offset, no noise) over the whole
+        input, (n,) [Pa]: after a stop at the stop speed the valve still follows its
+        current, so a measured run's pressure goes on after the simulation stopped."""
+        vector = self.params.vector()
+        pressure = np.empty(self.scenario.current_a.size)
+        actuator_kernel(vector, actuator_matrices(vector, self.scenario.step_s),
+                        self.scenario.current_a, pressure)
+        return pressure + self._pressure_offset_pa()
+
+    def to_run(self, noise_seed: int | None = None) -> Run:
+        """The run as the rig's sensors would log it (data contract), with sensor noise.
+
+        Noise std comes from ``sensors.*``; ``noise_seed`` makes it reproducible. The
+        pressure transducer reads ``sensors.pressure_offset_pa`` high when the
+        ``pressure_sensor_offset`` element is on.
+        """
+        rng = np.random.default_rng(noise_seed)
+        p = self.params
+
+        def sensed(values: np.ndarray, std_key: str) -> np.ndarray:
+            std = p.number(std_key)
+            return values + rng.normal(0.0, std, values.shape) if std > 0 else values.copy()
+
+        return Run(
+            name=self.scenario.name, source="simulation", time_s=self.time_s.copy(),
+            current_a=held_to_logged(self.current_a),
+            pressure_pa=sensed(self.pressure_pa + self._pressure_offset_pa(),
+                               "sensors.pressure_noise_pa"),
+            wheel_speed_rad_s=sensed(self.wheel_speed_rad_s, "sensors.speed_noise_rad_s"),
+            flywheel_speed_rad_s=sensed(self.speed_m_s / p.number("flywheel.radius_m"),
+                                        "sensors.speed_noise_rad_s"),
+            vertical_load_n=sensed(self.vertical_load_n, "sensors.force_noise_n"),
+            longitudinal_force_n=sensed(self.longitudinal_force_n, "sensors.force_noise_n"),
+        )
+
+
+BATCH_CHUNK = 16  # sets simulated at once: bounds the output buffer of a large batch
+
+
+def simulate(params: RigParameters, scenario: Scenario) -> SimulationResult:
+    """Simulate one scenario with one parameter set."""
+    vector = params.vector()
+    out = np.empty((scenario.current_a.size, N_CHANNELS))
+    rows, stop = run_kernel(vector, actuator_matrices(vector, scenario.step_s),
+                            scenario.current_a, scenario.step_s, scenario.contact,
+                            scenario.initial_speed_m_s, scenario.stop_speed_m_s, out)
+    return SimulationResult(scenario, params, out[:rows].copy(), STOP_REASONS[stop])
+
+
+def simulate_batch(params: Sequence[RigParameters], scenario: Scenario,
+                   current_a: np.ndarray | None = None) -> list[SimulationResult]:
+    """Simulate one scenario for many parameter sets in one call (parallel over sets).
+
+    Args:
+        params: the parameter sets.
+        scenario: shared timing, contact and stop rule.
+        current_a: optional per-set inputs, shape (len(params), n); defaults to
+            the scenario's current for every set.
+    """
+    inputs = scenario.current_a if current_a is None else np.asarray(current_a, dtype=float)
+    inputs = np.broadcast_to(inputs, (len(params), inputs.shape[-1]))
+    results: list[SimulationResult] = []
+    for start in range(0, len(params), BATCH_CHUNK):
+        chunk = list(params[start:start + BATCH_CHUNK])
+        results.extend(_simulate_chunk(chunk, scenario,
+                                       np.ascontiguousarray(inputs[start:start + len(chunk)])))
+    return results
+
+
+def _simulate_chunk(params: list[RigParameters], scenario: Scenario,
+                    inputs: np.ndarray) -> list[SimulationResult]:
+    vectors = np.stack([p.vector() for p in params])
+    matrices = np.stack([actuator_matrices(v, scenario.step_s) for v in vectors])
+    out = np.empty((len(params), inputs.shape[1], N_CHANNELS))
+    rows = np.zeros(len(params), dtype=np.int64)
+    stop = np.zeros(len(params), dtype=np.int64)
+    batch_kernel(vectors, matrices, inputs, scenario.step_s, scenario.contact,
+                 scenario.initial_speed_m_s, scenario.stop_speed_m_s, out, rows, stop)
+    return [SimulationResult(scenario, p, out[i, : rows[i]].copy(), STOP_REASONS[stop[i]])
+            for i, p in enumerate(params)]

@@ -1,0 +1,361 @@
+"""Model parameters: the schema, the params-file loader and validation.
+
+The numbers live in ROS 2 params files (``config/*.yaml``); this module declares
+each key once (:data:`SPECS`: unit, meaning, admissible range), loads and layers
+files, validates every value, and packs a parameter set into the flat float64
+vector the compiled physics reads (:data:`INDEX` gives each key's position).
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import os
+import sys
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from landing_gear_sim.errors import ParameterError
+
+ELEMENTS: tuple[str, ...] = ("gear_walk", "load_dependent_radius", "actuator_dynamics", "drag",
+                             "actuator_delay", "pressure_sensor_offset", "tire_relaxation",
+                             "brake_fade")
+"""Model elements that can be switched on or off (``elements.<name>``). The last ones are
+extensions the reference rig does not have (off in its file)."""
+
+CONFIGURATIONS: tuple[str, ...] = ("rig", "aircraft")
+
+
+@dataclass(frozen=True)
+class ParamSpec:
+    """One parameter: its key in the params file, unit, meaning and admissible range."""
+
+    key: str
+    unit: str
+    description: str
+    kind: str = "float"  # "float", "bool" or "choice"
+    positive: bool = False  # strictly > 0 (else >= 0)
+    signed: bool = False  # may be negative (an offset)
+    choices: tuple[str, ...] = ()
+
+
+def _f(key: str, unit: str, description: str, positive: bool = True) -> ParamSpec:
+    return ParamSpec(key, unit, description, positive=positive)
+
+
+SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("configuration", "-", "rig (flywheel) or aircraft (eqs. 5-6)", "choice",
+              choices=CONFIGURATIONS),
+    *(ParamSpec(f"elements.{name}", "-", f"{name} element switched on", "bool")
+      for name in ELEMENTS),
+    _f("flywheel.radius_m", "m", "flywheel radius R_f"),
+    _f("flywheel.inertia_kg_m2", "kg m^2", "flywheel inertia J_f"),
+    _f("drag.coeff_n_s2_per_m2", "N s^2/m^2", "drag coefficient alpha_d", positive=False),
+    _f("wheel.unloaded_radius_m", "m", "unloaded tyre radius r0"),
+    _f("wheel.inertia_kg_m2", "kg m^2", "wheel inertia J_w"),
+    _f("radius.a_m_per_n2", "m/N^2", "radius reduction, quadratic term a", positive=False),
+    _f("radius.b_m_per_n", "m/N", "radius reduction, linear term b", positive=False),
+    _f("radius.c_m", "m", "radius reduction, constant term c", positive=False),
+    _f("friction.theta1", "-", "Burckhardt theta1"),
+    _f("friction.theta2", "-", "Burckhardt theta2"),
+    _f("friction.theta3", "-", "Burckhardt theta3", positive=False),
+    _f("gear_walk.length_m", "m", "gear-walk lever L_gw"),
+    _f("gear_walk.inertia_kg_m2", "kg m^2", "gear inertia about the attachment"),
+    _f("gear_walk.stiffness_n_m_per_rad", "N m/rad", "gear-walk stiffness k_theta"),
+    _f("gear_walk.damping_n_m_s_per_rad", "N m s/rad", "gear-walk damping c_theta",
+       positive=False),
+    _f("aircraft.mass_kg", "kg", "aircraft mass share on this wheel m_a"),
+    _f("aircraft.wheel_mass_kg", "kg", "wheel mass m_w", positive=False),
+    _f("aircraft.gear_mass_kg", "kg", "gear mass m_gw", positive=False),
+    _f("brake.gain_n_m_per_pa", "N m/Pa", "brake gain k_b = mu_b A_p R_eff n_s"),
+    _f("brake.fade_fraction", "-", "gain lost when fully faded (brake_fade)", positive=False),
+    _f("brake.fade_energy_j", "J", "brake energy scale of the fade (brake_fade)"),
+    _f("tyre.relaxation_length_m", "m", "tyre relaxation length (tire_relaxation)",
+       positive=False),
+    _f("actuator.max_current_a", "A", "valve current range upper limit"),
+    _f("actuator.deadband_current_a", "A", "static map dead-band I0", positive=False),
+    _f("actuator.map_k1_pa_per_a", "Pa/A", "static map linear gain k1"),
+    _f("actuator.map_k2_pa_per_a2", "Pa/A^2", "static map curvature k2", positive=False),
+    _f("actuator.max_pressure_pa", "Pa", "static map saturation P_max"),
+    _f("actuator.gain", "-", "A(s) static gain"),
+    _f("actuator.natural_frequency_hz", "Hz", "A(s) natural frequency"),
+    _f("actuator.damping_ratio", "-", "A(s) damping ratio"),
+    _f("actuator.delay_s", "s", "transport delay current -> pressure (actuator_delay)",
+       positive=False),
+    _f("loading.static_load_n", "N", "vertical load at zero speed F_z0"),
+    _f("loading.lift_coeff_n_s2_per_m2", "N s^2/m^2", "lift coefficient k_L", positive=False),
+    _f("loading.servo_time_constant_s", "s", "loading-device servo time constant"),
+    _f("loading.touchdown_ramp_s", "s", "load ramp duration at touch-down", positive=False),
+    _f("rig_test.initial_speed_m_s", "m/s", "flywheel rim speed at the start v0",
+       positive=False),
+    _f("rig_test.touchdown_s", "s", "touch-down time", positive=False),
+    _f("rig_test.brake_start_s", "s", "braking starts t_brake", positive=False),
+    _f("rig_test.brake_ramp_s", "s", "current ramp-in at braking start", positive=False),
+    _f("rig_test.stop_speed_m_s", "m/s", "run stops when the flywheel is slower",
+       positive=False),
+    _f("rig_test.max_duration_s", "s", "longest run"),
+    _f("sensors.pressure_noise_pa", "Pa", "pressure transducer noise std", positive=False),
+    _f("sensors.speed_noise_rad_s", "rad/s", "encoder noise std", positive=False),
+    _f("sensors.force_noise_n", "N", "load-cell noise std", positive=False),
+    ParamSpec("sensors.pressure_offset_pa", "Pa",
+              "pressure transducer offset (pressure_sensor_offset)", signed=True),
+    _f("simulation.output_rate_hz", "Hz", "output (and input hold) rate"),
+)
+
+INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}
+N_PARAMS: int = len(SPECS)
+_SPEC_BY_KEY: dict[str, ParamSpec] = {spec.key: spec for spec in SPECS}
+_OWNED_SECTIONS: frozenset[str] = frozenset(key.split(".")[0] for key in INDEX)
+
+Value = float | bool | str
+
+
+def default_config_dir() -> Path:
+    """The bundled ``config/`` folder: source tree, then the install prefix's ``share/``."""
+    package = Path(__file__).resolve().parents[1]  # landing_gear_sim/
+    share = Path("share") / "landing_gear_sim" / "config"
+    # source tree (editable install), the prefix this copy is installed in
+    # (<prefix>/lib/pythonX.Y/site-packages/landing_gear_sim), ROS prefixes, the venv
+    own_prefix = [package.parents[3] / share] if len(package.parents) > 3 else []
+    candidates = [
+        package.parent / "config",
+        *own_prefix,
+        *(Path(p) / share for p in _ament_prefixes()),
+        Path(sys.prefix) / share,
+    ]
+    for candidate in candidates:
+        if (candidate / "reference_rig.yaml").is_file():
+            return candidate
+    raise ParameterError(
+        "cannot find the bundled config/reference_rig.yaml (looked in "
+        + ", ".join(str(c) for c in candidates) + ")"
+    )
+
+
+def _ament_prefixes() -> list[str]:
+    return [p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
+
+
+def default_config_files() -> list[Path]:
+    """The params files that define the reference rig."""
+    return [default_config_dir() / "reference_rig.yaml"]
+
+
+@dataclass(frozen=True)
+class RigParameters:
+    """A complete, validated parameter set.
+
+    ``values`` maps every key of :data:`SPECS` to its value (SI, as in the files);
+    ``sources`` names the files it came from, for messages and reports.
+    """
+
+    values: Mapping[str, Value]
+    sources: tuple[str, ...] = field(default=())
+
+    def __post_init__(self) -> None:
+        _check_values(self.values, {}, self.sources)
+
+    def __getitem__(self, key: str) -> Value:
+        return self.values[key]
+
+    def number(self, key: str) -> float:
+        """A numeric parameter as float."""
+        return float(self.values[key])  # type: ignore[arg-type]
+
+    def has(self, element: str) -> bool:
+        """Whether a switchable element is on."""
+        return bool(self.values[f"elements.{element}"])
+
+    @property
+    def configuration(self) -> str:
+        return str(self.values["configuration"])
+
+    def replace(self, overrides: Mapping[str, Value], source: str = "override") -> RigParameters:
+        """A copy with some values changed (validated like a file)."""
+        _check_known(overrides, source)
+        return RigParameters({**self.values, **overrides}, (*self.sources, source))
+
+    def without(self, *elements: str) -> RigParameters:
+        """A copy with the named elements switched off."""
+        unknown = [e for e in elements if e not in ELEMENTS]
+        if unknown:
+            raise ParameterError(
+                f"unknown element {unknown[0]!r}; switchable elements: {', '.join(ELEMENTS)}"
+            )
+        return self.replace({f"elements.{e}": False for e in elements}, "--without")
+
+    def vector(self) -> np.ndarray:
+        """The set packed for the compiled physics, shape ``(N_PARAMS,)``."""
+        out = np.empty(N_PARAMS)
+        for spec in SPECS:
+            value = self.values[spec.key]
+            if spec.kind == "choice":
+                out[INDEX[spec.key]] = spec.choices.index(str(value))
+            else:
+                out[INDEX[spec.key]] = float(value)  # type: ignore[arg-type]
+        return out
+
+    def to_yaml(self, path: Path, node: str = "/**") -> None:
+        """Write the set as a ROS 2 params file loadable by :func:`load_parameters`."""
+        nested: dict[str, Any] = {}
+        for spec in SPECS:
+            section = nested
+            *parents, leaf = spec.key.split(".")
+            for part in parents:
+                section = section.setdefault(part, {})
+            value = self.values[spec.key]
+            section[leaf] = float(value) if spec.kind == "float" else value  # type: ignore[arg-type]
+        text = yaml.safe_dump({node: {"ros__parameters": nested}}, sort_keys=False)
+        Path(path).write_text(text)
+
+
+def load_parameters(
+    files: Sequence[Path | str] | None = None,
+    overrides: Mapping[str, Value] | None = None,
+) -> RigParameters:
+    """Load and validate a parameter set.
+
+    Args:
+        files: params files, later ones overriding earlier ones; ``None`` means
+            the bundled reference rig. A file may hold only some keys (an overlay),
+            but the union must define every key.
+        overrides: final ``{key: value}`` changes (e.g. from ``--set``).
+
+    Raises:
+        ParameterError: a file is unreadable, or a value is missing, unknown,
+            negative, non-finite or of the wrong type; the message names the key
+            and the file.
+    """
+    paths = [Path(f) for f in files] if files else default_config_files()
+    values: dict[str, Value] = {}
+    origin: dict[str, str] = {}
+    for path in paths:
+        for key, value in read_params_file(path).items():
+            values[key] = _as_ros_reads_it(key, value)
+            origin[key] = str(path)
+    sources = tuple(str(p) for p in paths)
+    if overrides:
+        _check_known(overrides, "--set")
+        values.update(overrides)
+        origin.update(dict.fromkeys(overrides, "--set"))
+        sources = (*sources, "--set")
+    _check_values(values, origin, sources)
+    return RigParameters(values, sources)
+
+
+def read_params_file(path: Path) -> dict[str, Value]:
+    """The flattened model keys of one ROS 2 params file.
+
+    All node sections are merged in file order; sections the model does not own
+    (e.g. a controller's) are ignored, unknown keys in the model's sections are
+    an error (a typo would otherwise silently keep the default).
+    """
+    try:
+        document = yaml.safe_load(Path(path).read_text())
+    except OSError as exc:
+        raise ParameterError(f"{path}: cannot read params file ({exc.strerror})") from None
+    except yaml.YAMLError as exc:
+        raise ParameterError(f"{path}: not valid YAML ({_one_line(exc)})") from None
+    if not isinstance(document, dict):
+        raise ParameterError(f"{path}: not a ROS 2 params file (expected 'node: ros__parameters:')")
+    flat: dict[str, Value] = {}
+    for node, body in document.items():
+        if not isinstance(body, dict) or "ros__parameters" not in body:
+            raise ParameterError(f"{path}: section {node!r} has no 'ros__parameters'")
+        flat.update(_flatten(body["ros__parameters"] or {}))
+    owned = {k: v for k, v in flat.items() if k.split(".")[0] in _OWNED_SECTIONS}
+    _check_known(owned, str(path))
+    return owned
+
+
+def _as_ros_reads_it(key: str, value: Value) -> Value:
+    """PyYAML (YAML 1.1) reads ``6.9e5`` as text; ROS's parser reads a double: follow ROS."""
+    if isinstance(value, str) and _SPEC_BY_KEY[key].kind == "float":
+        try:
+            return float(value)
+        except ValueError:
+            return value
+    return value
+
+
+def _flatten(tree: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+    flat: dict[str, Any] = {}
+    for key, value in tree.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            flat.update(_flatten(value, name + "."))
+        else:
+            flat[name] = value
+    return flat
+
+
+def _one_line(exc: Exception) -> str:
+    return " ".join(str(exc).split())
+
+
+def _check_known(values: Iterable[str], source: str) -> None:
+    for key in values:
+        if key not in _SPEC_BY_KEY:
+            hint = difflib.get_close_matches(key, INDEX, n=1)
+            suggestion = f" (did you mean {hint[0]!r}?)" if hint else ""
+            raise ParameterError(f"{source}: unknown parameter {key!r}{suggestion}")
+
+
+_NEEDS_POSITIVE = {"tire_relaxation": "tyre.relaxation_length_m"}
+"""An element that is on needs this parameter > 0."""
+
+
+def _check_values(values: Mapping[str, Any], origin: Mapping[str, str],
+                  sources: Sequence[str]) -> None:
+    for spec in SPECS:
+        if spec.key not in values:
+            raise ParameterError(
+                f"parameter {spec.key!r} is missing (looked in {', '.join(sources)})"
+            )
+        problem = _problem(spec, values[spec.key])
+        if problem:
+            where = origin.get(spec.key) or ", ".join(sources) or "parameters"
+            raise ParameterError(f"{where}: parameter {spec.key!r} {problem}")
+    for element, key in _NEEDS_POSITIVE.items():
+        if values[f"elements.{element}"] and values[key] <= 0:
+            where = origin.get(key) or ", ".join(sources) or "parameters"
+            raise ParameterError(f"{where}: parameter {key!r} must be > 0 when "
+                                 f"elements.{element} is true")
+    if values["brake.fade_fraction"] >= 1:
+        raise ParameterError(f"{origin.get('brake.fade_fraction') or ', '.join(sources)}: "
+                             "parameter 'brake.fade_fraction' must be < 1")
+
+
+def _problem(spec: ParamSpec, value: Any) -> str | None:
+    """Why ``value`` is not admissible for ``spec``, or None."""
+    if spec.kind == "bool":
+        return None if isinstance(value, bool) else f"must be true or false, got {value!r}"
+    if spec.kind == "choice":
+        return None if value in spec.choices else (
+            f"must be one of {', '.join(spec.choices)}, got {value!r}")
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return f"must be a number [{spec.unit}], got {value!r}"
+    if not math.isfinite(value):
+        return f"must be finite, got {value!r}"
+    if value < 0 and not spec.signed:
+        return f"must not be negative, got {value!r} [{spec.unit}]"
+    if spec.positive and value == 0:
+        return f"must be > 0, got {value!r} [{spec.unit}]"
+    return None
+
+
+def parse_assignment(text: str) -> tuple[str, Value]:
+    """Parse ``KEY=VALUE`` from the command line; the value is read as YAML."""
+    key, sep, raw = text.partition("=")
+    if not sep or not key:
+        raise ParameterError(f"--set expects KEY=VALUE, got {text!r}")
+    try:
+        value = yaml.safe_load(raw)
+    except yaml.YAMLError:
+        value = raw
+    return key.strip(), value

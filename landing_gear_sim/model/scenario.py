@@ -1,0 +1,218 @@
+"""Test scenarios: the rig procedure of paper Section III and the open-loop current profiles.
+
+A :class:`Scenario` is everything a run needs besides the parameters: the valve
+current reference sampled at the output rate (held over each sample), whether the
+wheel touches the flywheel, the initial speed and the stop rule. Profiles are
+functions of the time since the profile started, returning current [A].
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import scipy.signal
+
+from landing_gear_sim.errors import ScenarioError
+from landing_gear_sim.model.parameters import RigParameters
+
+Profile = Callable[[np.ndarray], np.ndarray]
+"""Current reference [A] as a function of time since the profile started [s], shapes (n,)."""
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One rig test to simulate.
+
+    Attributes:
+        name: short identifier, used in file names and reports.
+        current_a: valve current reference, shape (n,), sample k held over
+            [k/rate, (k+1)/rate).
+        rate_hz: sample (and output) rate.
+        contact: wheel pressed on the flywheel (braking test); False for an
+            actuator-only test (speeds and loads stay 0).
+        initial_speed_m_s: flywheel rim (or aircraft) speed at t = 0.
+        stop_speed_m_s: the run ends when the speed falls below this; 0 runs to
+            the end of the input.
+    """
+
+    name: str
+    current_a: np.ndarray
+    rate_hz: float
+    contact: bool
+    initial_speed_m_s: float
+    stop_speed_m_s: float
+    description: str = field(default="")
+
+    def __post_init__(self) -> None:
+        current = np.asarray(self.current_a, dtype=float)
+        if current.ndim != 1 or current.size < 2:
+            raise ScenarioError(f"{self.name}: the current profile needs at least 2 samples")
+        if not np.all(np.isfinite(current)):
+            raise ScenarioError(f"{self.name}: the current profile has NaN or infinite values")
+        if not (math.isfinite(self.rate_hz) and self.rate_hz > 0):
+            raise ScenarioError(f"{self.name}: rate must be > 0 Hz, got {self.rate_hz}")
+        object.__setattr__(self, "current_a", current)
+
+    @property
+    def step_s(self) -> float:
+        return 1.0 / self.rate_hz
+
+    @property
+    def duration_s(self) -> float:
+        return self.current_a.size / self.rate_hz
+
+
+def sample_times(duration_s: float, rate_hz: float) -> np.ndarray:
+    """Sample instants k/rate for k = 0 .. round(duration·rate) − 1."""
+    return np.arange(round(duration_s * rate_hz)) / rate_hz
+
+
+# --- profiles -------------------------------------------------------------------------
+
+def constant(level_a: float) -> Profile:
+    """A constant current."""
+    return lambda t: np.full_like(t, level_a, dtype=float)
+
+
+def quasi_static_ramp(peak_a: float = 1.0, duration_s: float = 20.0) -> Profile:
+    """Slow triangle 0 → peak → 0 over ``duration_s``, for the static map (paper Fig. 8)."""
+    half = duration_s / 2.0
+    return lambda t: peak_a * np.clip(1.0 - np.abs(t - half) / half, 0.0, 1.0)
+
+
+def steps(levels_a: tuple[float, ...] = (0.2, 0.5, 0.8, 0.35), hold_s: float = 2.0) -> Profile:
+    """A staircase of current steps, each held ``hold_s`` (paper Fig. 9 left)."""
+    levels = np.asarray(levels_a, dtype=float)
+
+    def profile(t: np.ndarray) -> np.ndarray:
+        return levels[np.clip((t // hold_s).astype(int), 0, levels.size - 1)]
+
+    return profile
+
+
+def sine_sweep(f0_hz: float = 0.5, f1_hz: float = 100.0, duration_s: float = 20.0,
+               mean_a: float = 0.5, amplitude_a: float = 0.15) -> Profile:
+    """Logarithmic sine sweep f0 → f1 around ``mean_a`` (paper Fig. 9 right)."""
+    def profile(t: np.ndarray) -> np.ndarray:
+        tt = np.clip(t, 0.0, duration_s)
+        wave = scipy.signal.chirp(tt, f0_hz, duration_s, f1_hz, method="logarithmic", phi=-90)
+        return mean_a + amplitude_a * wave
+
+    return profile
+
+
+def oscillating(high_a: float, depth_a: float, frequency_hz: float) -> Profile:
+    """Current at ``high_a`` with periodic releases of ``depth_a`` (paper Fig. 14)."""
+    return lambda t: high_a - depth_a * 0.5 * (1.0 - np.cos(2.0 * np.pi * frequency_hz * t))
+
+
+OSC_LOW = {"high_a": 0.75, "depth_a": 0.35, "frequency_hz": 2.0}
+"""Deep low-frequency releases (paper Fig. 14a)."""
+OSC_HIGH = {"high_a": 0.70, "depth_a": 0.12, "frequency_hz": 6.0}
+"""Shallow high-frequency releases (paper Fig. 14b)."""
+
+
+def steps_then_sweep() -> Profile:
+    """Actuator identification input: current steps, then the 0.5 → 100 Hz sweep."""
+    stair, sweep, t_sweep = steps(), sine_sweep(), 8.0
+    return lambda t: np.where(t < t_sweep, stair(t), sweep(t - t_sweep))
+
+
+def logged_to_held(current_logged_a: np.ndarray) -> np.ndarray:
+    """Model input from a logged current.
+
+    In a run log (CSV row, bag sample) the current at t_k is the command in force
+    over the interval that *ends* at t_k, so the pressure sampled at t_k already
+    reflects it (rig loggers and the example campaigns follow this). The model
+    holds sample k over [t_k, t_{k+1}): shift by one sample.
+    """
+    logged = np.asarray(current_logged_a, dtype=float)
+    return np.concatenate([logged[1:], logged[-1:]])
+
+
+def held_to_logged(current_held_a: np.ndarray) -> np.ndarray:
+    """Inverse of :func:`logged_to_held`: the current as a run log shows it."""
+    held = np.asarray(current_held_a, dtype=float)
+    return np.concatenate([held[:1], held[:-1]])
+
+
+def from_samples(time_s: np.ndarray, current_a: np.ndarray, name: str = "file") -> Profile:
+    """A recorded current, held between samples (zero-order hold), last value after the end."""
+    times = np.asarray(time_s, dtype=float)
+    values = np.asarray(current_a, dtype=float)
+    if times.size < 2 or np.any(np.diff(times) <= 0):
+        raise ScenarioError(f"{name}: time must be strictly increasing with >= 2 samples")
+    if not np.all(np.isfinite(values)):
+        raise ScenarioError(f"{name}: the current has NaN or infinite values")
+
+    def profile(t: np.ndarray) -> np.ndarray:
+        idx = np.searchsorted(times - times[0], t + 1e-9, side="right") - 1
+        return values[np.clip(idx, 0, values.size - 1)]
+
+    return profile
+
+
+def from_file(path: Path) -> tuple[Profile, float]:
+    """The recorded current of a run (CSV or bag); returns the profile and its duration."""
+    from msg_tools.io import read_run  # run I/O lives in msg_tools
+
+    run = read_run(Path(path))
+    profile = from_samples(run.time_s, logged_to_held(run.current_a), str(path))
+    return profile, float(run.time_s[-1] - run.time_s[0]) + 1.0 / run.rate_hz
+
+
+# --- scenarios ------------------------------------------------------------------------
+
+def current_for_pressure(params: RigParameters, pressure_pa: float) -> float:
+    """Valve current whose static-map pressure is ``pressure_pa`` (inverse of the map)."""
+    k1, k2 = params.number("actuator.map_k1_pa_per_a"), params.number("actuator.map_k2_pa_per_a2")
+    p_max = params.number("actuator.max_pressure_pa")
+    if not 0.0 <= pressure_pa <= p_max:
+        raise ScenarioError(
+            f"pressure {pressure_pa / 1e5:g} bar is outside the valve range 0..{p_max / 1e5:g} bar"
+        )
+    target = pressure_pa / params.number("actuator.gain")
+    excess = target / k1 if k2 == 0 else (-k1 + math.sqrt(k1 * k1 + 4 * k2 * target)) / (2 * k2)
+    current = params.number("actuator.deadband_current_a") + excess
+    if current > params.number("actuator.max_current_a"):
+        raise ScenarioError(f"pressure {pressure_pa / 1e5:g} bar needs more than the valve's "
+                            f"{params.number('actuator.max_current_a'):g} A")
+    return current
+
+
+def rig_test(params: RigParameters, braking: Profile, name: str = "rig_test",
+             rate_hz: float | None = None) -> Scenario:
+    """The rig procedure: flywheel at v0, touch-down with load ramp, spin-up, braking.
+
+    The current is 0 until ``rig_test.brake_start_s``, then follows ``braking``
+    (time measured from the braking start), ramped in over ``rig_test.brake_ramp_s``.
+    The run ends when the flywheel falls below ``rig_test.stop_speed_m_s`` or after
+    ``rig_test.max_duration_s``.
+    """
+    rate = rate_hz or params.number("simulation.output_rate_hz")
+    t = sample_times(params.number("rig_test.max_duration_s"), rate)
+    since = t - params.number("rig_test.brake_start_s")
+    ramp_s = params.number("rig_test.brake_ramp_s")
+    ramp = np.clip(since / ramp_s, 0.0, 1.0) if ramp_s > 0 else (since >= 0).astype(float)
+    current = np.where(since >= 0, braking(np.maximum(since, 0.0)) * ramp, 0.0)
+    return Scenario(name, current, rate, True, params.number("rig_test.initial_speed_m_s"),
+                    params.number("rig_test.stop_speed_m_s"), "rig test, braking profile")
+
+
+def actuator_test(params: RigParameters, profile: Profile, duration_s: float,
+                  name: str = "actuator_test", rate_hz: float | None = None) -> Scenario:
+    """Wheel off the flywheel: only the valve and brake pressure respond."""
+    rate = rate_hz or params.number("simulation.output_rate_hz")
+    current = profile(sample_times(duration_s, rate))
+    return Scenario(name, current, rate, False, 0.0, 0.0, "actuator-only test")
+
+
+def constant_pressure_test(params: RigParameters, pressure_pa: float,
+                           rate_hz: float | None = None) -> Scenario:
+    """Rig test braking at the current that gives ``pressure_pa`` in steady state."""
+    level = current_for_pressure(params, pressure_pa)
+    return rig_test(params, constant(level), f"brake_const_{pressure_pa / 1e5:g}bar", rate_hz)

@@ -1,0 +1,85 @@
+"""Figures. Functions take computed results and draw them; they never simulate.
+
+matplotlib runs on the non-interactive Agg backend: figures go to PNG files.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+from landing_gear_sim.model.integrate import SimulationResult
+from landing_gear_sim.model.linear import FrequencyResponse
+
+
+def save_figure(fig: plt.Figure, path: Path) -> Path:
+    """Write ``fig`` as PNG (creating the folder) and close it."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_simulation(result: SimulationResult, path: Path) -> Path:
+    """Speeds, slip, pressure and current, forces of one run (paper Figs. 1 and 14 style)."""
+    t = result.time_s
+    fig, axes = plt.subplots(4, 1, figsize=(9, 10), sharex=True)
+    axes[0].plot(t, result.hub_speed_m_s, "k", label="hub speed $v_h$")
+    axes[0].plot(t, result.wheel_speed_rad_s * result.rolling_radius_m, "r",
+                 label=r"wheel speed $\omega r$")
+    axes[0].set_ylabel("speed [m/s]")
+    axes[1].plot(t, result.slip, "b")
+    axes[1].set_ylabel(r"slip $\lambda$ [-]")
+    axes[1].set_ylim(-0.05, 1.05)
+    axes[2].plot(t, result.pressure_pa / 1e5, "m", label="brake pressure")
+    axes[2].set_ylabel("pressure [bar]")
+    current_axis = axes[2].twinx()
+    current_axis.plot(t, result.current_a, color="grey", lw=0.8, label="valve current")
+    current_axis.set_ylabel("current [A]")
+    axes[3].plot(t, result.vertical_load_n / 1e3, "g", label="vertical load $F_z$")
+    axes[3].plot(t, result.longitudinal_force_n / 1e3, "c", label="tyre force $F_x$")
+    axes[3].set_ylabel("force [kN]")
+    axes[3].set_xlabel("time [s]")
+    for axis in (axes[0], axes[2], axes[3]):
+        axis.legend(loc="upper right")
+    for axis in axes:
+        axis.grid(alpha=0.3)
+    fig.suptitle(f"{result.scenario.name}: {result.scenario.description} "
+                 f"({result.stop_reason} at {t[-1]:.2f} s)")
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def plot_bode(responses: Sequence[FrequencyResponse], path: Path) -> Path:
+    """G_λ and G_η magnitude and phase, with (solid red) and without (dash-dot black)
+    gear walk, one line per speed (paper Fig. 7)."""
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
+    speeds = sorted({r.speed_m_s for r in responses})
+    shade = {v: 0.35 + 0.65 * i / max(len(speeds) - 1, 1) for i, v in enumerate(speeds)}
+    for response in responses:
+        style = ({"color": "red", "ls": "-"} if response.gear_walk
+                 else {"color": "black", "ls": "-."})
+        label = f"{response.speed_m_s:g} m/s, {'with' if response.gear_walk else 'no'} gear walk"
+        for col, values in enumerate((response.slip, response.decel)):
+            axes[0, col].semilogx(response.frequency_hz, 20 * np.log10(np.abs(values)),
+                                  alpha=shade[response.speed_m_s], label=label, **style)
+            axes[1, col].semilogx(response.frequency_hz, np.degrees(np.unwrap(np.angle(values))),
+                                  alpha=shade[response.speed_m_s], **style)
+    axes[0, 0].set_title(r"$G_\lambda$: brake torque → slip")
+    axes[0, 1].set_title(r"$G_\eta$: brake torque → normalised wheel deceleration")
+    axes[0, 0].set_ylabel("magnitude [dB re 1/(N m)]")
+    axes[1, 0].set_ylabel("phase [deg]")
+    for axis in axes[1]:
+        axis.set_xlabel("frequency [Hz]")
+    for axis in axes.flat:
+        axis.grid(alpha=0.3, which="both")
+    axes[0, 0].legend(fontsize=7)
+    fig.tight_layout()
+    return save_figure(fig, path)

@@ -1,0 +1,195 @@
+"""The node graph, described once: which nodes, their parameters and their topics.
+
+Both ways of bringing the graph up read this description: the ROS launch file
+(``launch/rig.launch.py``) turns each :class:`NodeSpec` into a launch ``Node``, and
+``landing-gear-sim rig`` (:mod:`landing_gear_sim.ros.launcher`) into a process. No ROS here.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.model.runspec import RunSpec
+from msg_tools.contract import (
+    TOPIC_CURRENT,
+    TOPIC_FLYWHEEL,
+    TOPIC_PRESSURE,
+    TOPIC_WHEEL,
+    TOPIC_WRENCH,
+)
+
+PACKAGE = "landing_gear_sim"
+
+TOPIC_HYDRAULIC = "/rig/brake/hydraulic_pressure"
+"""Actuator → plant: pressure applied to the brake (sensor_msgs/FluidPressure, absolute)."""
+TOPIC_LOAD = "/rig/loading/vertical_force"
+"""Loading device → plant: vertical force on the gear (geometry_msgs/Vector3Stamped, z [N])."""
+TOPIC_RUN_END = "/rig/run_end"
+"""Plant → everyone: the run is over; data = number of samples (std_msgs/UInt64, latched)."""
+TOPIC_READY = "/rig/ready"
+"""Peers → plant: a node's links are matched (std_msgs/String node name, latched)."""
+TOPIC_CLOCK = "/clock"
+
+SENSOR_TOPICS = (TOPIC_WHEEL, TOPIC_FLYWHEEL, TOPIC_PRESSURE, TOPIC_WRENCH)
+RECORDED_TOPICS = (TOPIC_CURRENT, *SENSOR_TOPICS)
+
+CONTROLLER_NODE = "antiskid_controller"
+CLOCKS = ("lockstep", "realtime")
+STORAGES = ("mcap", "sqlite3")
+
+ParamValue = bool | int | float | str | list[str]
+
+
+@dataclass(frozen=True)
+class NodeSpec:
+    """One node of the graph: executable (= node name), its own parameters, its topics."""
+
+    name: str
+    parameters: dict[str, ParamValue]
+    publishes: tuple[str, ...]
+    subscribes: tuple[str, ...]
+
+    @property
+    def module(self) -> str:
+        """Python module whose ``main`` runs this node."""
+        if self.name == CONTROLLER_NODE:
+            return "antiskid.node"
+        return f"{PACKAGE}.ros.nodes.{self.name}"
+
+
+@dataclass(frozen=True)
+class GraphOptions:
+    """Everything that decides the graph of one rig session.
+
+    Attributes:
+        run: what to run (profile or ``external`` when a controller drives the brake).
+        clock: ``lockstep`` (sim time, data-driven, deterministic) or ``realtime``.
+        bag: rosbag2 folder to record into; None: no recorder.
+        storage: ``mcap`` or ``sqlite3``.
+        sensor_noise: add the ``sensors.*`` noise to the published sensor values.
+        timeout_s: lockstep: how long the plant waits for a peer before holding its input.
+        safe_pressure_pa: brake pressure the plant applies when the actuator is lost.
+        controller: anti-skid controller node to run instead of the profile node.
+        replay: the run's current comes from the ``replay`` node (``run.file``), not
+            the profile node.
+    """
+    # a controller graph is a rig test braking from rig_test.brake_start_s: run.profile
+    # is "external" (see controlled_run)
+
+    run: RunSpec = field(default_factory=RunSpec)
+    clock: str = "lockstep"
+    bag: Path | None = None
+    storage: str = "mcap"
+    sensor_noise: bool = False
+    timeout_s: float = 10.0  # long: a starved (not dead) node must not be declared lost
+    safe_pressure_pa: float = 0.0
+    controller: str | None = None
+    replay: bool = False
+
+    def __post_init__(self) -> None:
+        if self.clock not in CLOCKS:
+            raise LandingGearSimError(f"clock must be one of {', '.join(CLOCKS)}")
+        if self.storage not in STORAGES:
+            raise LandingGearSimError(f"storage must be one of {', '.join(STORAGES)}")
+        if not (math.isfinite(self.timeout_s) and self.timeout_s > 0):
+            raise LandingGearSimError("the lockstep timeout must be > 0 s")
+        if self.replay and self.run.profile != "file":
+            raise LandingGearSimError("a replay graph needs the run file (profile 'file')")
+
+
+LAUNCH_ARGUMENTS: dict[str, tuple[str, str]] = {
+    "profile": ("osc-low", "current profile (simulate's --profile), or file"),
+    "file": ("", "profile file: run (CSV or bag) whose current drives the graph"),
+    "pressure_bar": ("30", "constant profile: brake pressure [bar]"),
+    "clock": ("lockstep", "lockstep | realtime"),
+    "params_file": ("", "ROS 2 params file of the rig (default: bundled reference rig)"),
+    "bag": ("", "rosbag2 folder to record into (empty: no recorder)"),
+    "storage": ("mcap", "mcap | sqlite3"),
+    "controller": ("", "anti-skid controller type instead of the profile (threshold | slip)"),
+}
+"""Launch-file arguments: name -> (default, description)."""
+
+
+def controlled_run(run: RunSpec, controller: str | None) -> RunSpec:
+    """The run of a graph: ``run``, or with a controller driving the brake, a rig test
+    at the same rate whose current comes from outside (profile ``external``)."""
+    return RunSpec(profile="external", rate_hz=run.rate_hz) if controller else run
+
+
+def options_from_arguments(values: dict[str, str]) -> tuple[GraphOptions, Path]:
+    """GraphOptions and params file from launch arguments (strings, see LAUNCH_ARGUMENTS)."""
+    from landing_gear_sim.model.parameters import default_config_files
+
+    def value(name: str) -> str:
+        return values.get(name, LAUNCH_ARGUMENTS[name][0])
+
+    try:
+        pressure_pa = float(value("pressure_bar")) * 1e5
+    except ValueError:
+        raise LandingGearSimError(
+            f"pressure_bar must be a number, got {value('pressure_bar')!r}") from None
+    controller = value("controller") or None
+    run = controlled_run(RunSpec(profile=value("profile"), file=value("file"),
+                                 pressure_pa=pressure_pa), controller)
+    options = GraphOptions(run=run, clock=value("clock"), storage=value("storage"),
+                           bag=Path(value("bag")) if value("bag") else None,
+                           controller=controller)
+    return options, Path(value("params_file") or default_config_files()[0])
+
+
+def run_parameters(run: RunSpec) -> dict[str, ParamValue]:
+    """The ``run.*`` node parameters that rebuild ``run`` (see nodes.common.run_spec)."""
+    return {"run.profile": run.profile, "run.pressure_pa": run.pressure_pa,
+            "run.current_a": -1.0 if math.isnan(run.current_a) else run.current_a,
+            "run.file": run.file, "run.contact": run.contact,
+            "run.duration_s": run.duration_s, "run.rate_hz": run.rate_hz}
+
+
+def describe(options: GraphOptions) -> list[NodeSpec]:
+    """The nodes of the graph for ``options``, plant first, with their expected links."""
+    run = run_parameters(options.run)
+    clock = {"clock": options.clock}
+    nodes = [
+        NodeSpec("plant", {**run, **clock, "sensor_noise": options.sensor_noise,
+                           "timeout_s": options.timeout_s,
+                           "safe_pressure_pa": options.safe_pressure_pa},
+                 (*SENSOR_TOPICS, TOPIC_CLOCK, TOPIC_RUN_END), (TOPIC_HYDRAULIC, TOPIC_LOAD)),
+        NodeSpec("actuator", {**run, **clock}, (TOPIC_HYDRAULIC,), (TOPIC_CURRENT,)),
+        NodeSpec("loading_device", {**run, **clock}, (TOPIC_LOAD,), (TOPIC_FLYWHEEL,)),
+    ]
+    if options.controller:
+        nodes.append(NodeSpec(CONTROLLER_NODE, {**run, **clock, "type": options.controller},
+                              (TOPIC_CURRENT,), (TOPIC_WHEEL, TOPIC_FLYWHEEL)))
+    elif options.replay:
+        nodes.append(NodeSpec("replay", {**run, **clock, "topics": "current",
+                                         "file": options.run.file},
+                              (TOPIC_CURRENT,), (TOPIC_WHEEL,)))
+    else:
+        nodes.append(NodeSpec("profile", {**run, **clock}, (TOPIC_CURRENT,), (TOPIC_WHEEL,)))
+    if options.bag is not None:
+        nodes.append(NodeSpec("recorder", {**clock, "bag": str(options.bag),
+                                           "storage": options.storage},
+                              (), RECORDED_TOPICS))
+    return _with_links(nodes)
+
+
+def _with_links(nodes: list[NodeSpec]) -> list[NodeSpec]:
+    """Tell every node how many subscribers its outputs must have, and the plant its peers.
+
+    Lockstep starts only when every link is matched: a message published before its
+    reader is matched would be lost and the run would wait for it forever.
+    """
+    readers = Counter(topic for node in nodes for topic in node.subscribes)
+    linked = []
+    for node in nodes:
+        expected = [f"{topic}={readers[topic]}" for topic in node.publishes if readers[topic]]
+        extra: dict[str, ParamValue] = {"expected_subscribers": expected}
+        if node.name == "plant":
+            extra["peers"] = [n.name for n in nodes if n.name != "plant"]
+        linked.append(NodeSpec(node.name, {**node.parameters, **extra}, node.publishes,
+                               node.subscribes))
+    return linked

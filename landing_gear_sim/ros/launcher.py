@@ -1,0 +1,143 @@
+"""Bring the graph up without a ROS install: every node of :func:`graph.describe` as a process.
+
+``landing-gear-sim rig`` uses this: start the nodes, wait for the run to end, stop
+them cleanly, leave the bag. The ROS launch file starts the same description.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.ros.graph import GraphOptions, NodeSpec, ParamValue, describe
+
+LINGER_S = 10.0  # after the plant ends, how long the others may take to finish on their own
+STOP_S = 5.0  # after SIGINT, how long before SIGKILL
+PR_SET_PDEATHSIG = 1
+
+
+def ros_environment(environ: dict[str, str] | None = None) -> dict[str, str]:
+    """The environment for the nodes: DDS on this machine, a private domain unless chosen."""
+    env = dict(os.environ if environ is None else environ)
+    env.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+    env.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
+    env.setdefault("PYTHONUNBUFFERED", "1")
+    return env
+
+
+def format_value(value: ParamValue) -> str:
+    """A parameter value as ``-p name:=VALUE`` expects it (YAML, strings quoted)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return repr(value)
+    if isinstance(value, list):
+        return "[" + ", ".join(format_value(v) for v in (value or [""])) + "]"
+    return "'" + str(value).replace("'", "''") + "'"
+
+
+def node_command(node: NodeSpec, params_file: Path, python: str = sys.executable) -> list[str]:
+    """The command line that runs ``node`` with the graph's params file."""
+    overrides = [arg for name, value in node.parameters.items()
+                 for arg in ("-p", f"{name}:={format_value(value)}")]
+    return [python, "-m", node.module, "--ros-args", "--params-file", str(params_file),
+            *overrides]
+
+
+@dataclass
+class Outcome:
+    """How a graph run ended: exit code per node, and whether the user interrupted it."""
+
+    exit_codes: dict[str, int]
+    interrupted: bool = False
+
+    @property
+    def ok(self) -> bool:
+        return not self.interrupted and self.exit_codes.get("plant") == 0
+
+
+def run_graph(options: GraphOptions, params: RigParameters,
+              say: Callable[[str], None] = print) -> Outcome:
+    """Start the graph of ``options``, wait for the plant to finish the run, stop the rest."""
+    with tempfile.TemporaryDirectory(prefix="landing_gear_sim_") as workdir:
+        params_file = Path(workdir) / "rig_params.yaml"
+        params.to_yaml(params_file)
+        return _run_processes(options, params_file, say)
+
+
+def _run_processes(options: GraphOptions, params_file: Path,
+                   say: Callable[[str], None]) -> Outcome:
+    env = ros_environment()
+    nodes = describe(options)
+    say(f"starting {', '.join(n.name for n in nodes)} (ROS_DOMAIN_ID={env['ROS_DOMAIN_ID']}, "
+        f"discovery {env['ROS_AUTOMATIC_DISCOVERY_RANGE']})")
+    processes = {n.name: subprocess.Popen(node_command(n, params_file), env=env,
+                                          preexec_fn=_die_with_parent) for n in nodes}
+    interrupted = False
+    previous = signal.signal(signal.SIGTERM, _interrupt)
+    try:
+        _wait_for_plant(processes, say)
+        _wait_all(processes, LINGER_S)
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        _stop(processes)
+    return Outcome(_codes(processes), interrupted)
+
+
+def _interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt  # SIGTERM stops the graph like Ctrl-C: the bag is closed
+
+
+def _die_with_parent() -> None:
+    """Linux: a node gets SIGTERM if the launcher is killed, rather than running on."""
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+
+
+def _wait_for_plant(processes: dict[str, subprocess.Popen], say: Callable[[str], None]) -> None:
+    reported: set[str] = set()
+    while processes["plant"].poll() is None:
+        for name, process in processes.items():
+            code = process.poll()
+            if code is None or name in reported:
+                continue
+            reported.add(name)
+            if code == 2:  # a configuration error: the run cannot start
+                raise LandingGearSimError(f"node {name} refused its configuration (see above)")
+            if code != 0:
+                say(f"node {name} died (exit code {code}); the plant holds its input")
+        time.sleep(0.05)
+
+
+def _wait_all(processes: dict[str, subprocess.Popen], timeout_s: float) -> None:
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline and any(p.poll() is None for p in processes.values()):
+        time.sleep(0.05)
+
+
+def _stop(processes: dict[str, subprocess.Popen]) -> None:
+    """SIGINT whatever still runs (the recorder closes its bag), SIGKILL what hangs."""
+    for process in processes.values():
+        if process.poll() is None:
+            process.send_signal(signal.SIGINT)
+    _wait_all(processes, STOP_S)
+    for process in processes.values():
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+
+
+def _codes(processes: dict[str, subprocess.Popen]) -> dict[str, int]:
+    return {name: int(process.returncode) for name, process in processes.items()}

@@ -1,0 +1,44 @@
+"""``loading_device`` node: lift map + servo; flywheel speed at t_k → vertical force at t_{k+1}."""
+
+from __future__ import annotations
+
+from geometry_msgs.msg import Vector3Stamped
+from sensor_msgs.msg import JointState
+
+from landing_gear_sim.model.blocks import LoadingBlock, step_time
+from landing_gear_sim.ros.graph import TOPIC_LOAD
+from landing_gear_sim.ros.nodes.common import (
+    GraphNode,
+    Handshake,
+    announce_ready,
+    main_for,
+    rig_and_run,
+    step_of,
+    to_stamp,
+)
+from msg_tools.contract import TOPIC_FLYWHEEL
+
+
+class LoadingDeviceNode(GraphNode):
+    def __init__(self) -> None:
+        super().__init__("loading_device")
+        params, scenario, _ = rig_and_run(self)
+        self._rate_hz, self._step_s = scenario.rate_hz, scenario.step_s
+        self._block = LoadingBlock(params, scenario.step_s, scenario.contact)
+        self._message = Vector3Stamped()
+        self._message.header.frame_id = "gear"
+        self._out = self.publisher(Vector3Stamped, TOPIC_LOAD)
+        speed = self.subscription(JointState, TOPIC_FLYWHEEL, self._on_speed)
+        Handshake(self, {TOPIC_LOAD: self._out}, [speed], announce_ready(self))
+
+    def _on_speed(self, message: JointState) -> None:
+        step = step_of(message.header.stamp, self._rate_hz)
+        self._message.vector.z = self._block.step(step, message.velocity[0])
+        self._message.header.stamp = to_stamp(step_time(step + 1, self._step_s))
+        self._out.publish(self._message)
+
+
+main = main_for(LoadingDeviceNode)
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,143 @@
+"""``recorder`` node: the contract topics into a rosbag2 (mcap by default, or sqlite3).
+
+Messages are recorded as the raw bytes received (no re-serialisation), sample by
+sample in a fixed topic order, each with the sample's stamp as log time; the j-th
+current command is logged at the stamp of sample j+1, as the data contract reads it
+(the command in force over the interval that ends there). So the same run gives the
+same bag files, whatever the machine load.
+
+The bag is written in segments (see :mod:`msg_tools.bag_segments`) of at least
+``segment_s`` of sim time and ``segment_samples`` samples — a rule on the data, so the
+files are the same on every run. SIGINT/SIGTERM close the bag complete; after SIGKILL it
+still opens and lacks only the open segment: about half a second of wall time at the
+graph's real-time factors (closing a segment costs ~30 ms, so at a high real-time factor
+the sample floor keeps the recorder from spending its time closing segments).
+"""
+
+from __future__ import annotations
+
+import struct
+import time
+from pathlib import Path
+
+from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.ros.graph import SENSOR_TOPICS
+from landing_gear_sim.ros.nodes.common import (
+    CONTRACT_KINDS,
+    DATA_QOS,
+    GraphNode,
+    Handshake,
+    announce_ready,
+    declare,
+    lockstep,
+    main_for,
+)
+from msg_tools.bag_segments import SegmentedBagWriter
+from msg_tools.contract import TOPIC_CURRENT, TOPIC_TYPES, TOPIC_WHEEL
+
+LAG_SAMPLES = 2000  # a sample still missing a message this far behind is written without it
+END_GRACE_S = 5.0  # after the run's end, wait this long for messages still in flight
+
+
+def stamp_ns(raw: bytes) -> int:
+    """Header stamp [ns] of a serialized stamped message (CDR, header first)."""
+    order = "<" if raw[1] == 1 else ">"
+    sec, nanosec = struct.unpack_from(order + "iI", raw, 4)
+    return sec * 1_000_000_000 + nanosec
+
+
+class RecorderNode(GraphNode):
+    def __init__(self) -> None:
+        super().__init__("recorder")
+        lockstep(self)
+        path = str(declare(self, "bag", "", "rosbag2 folder to create"))
+        storage = str(declare(self, "storage", "mcap", "mcap | sqlite3"))
+        self._segment_ns = round(float(declare(self, "segment_s", 0.5, "sim time per closed "
+                                               "segment [s]: the most a crash loses")) * 1e9)
+        self._segment_samples = int(declare(self, "segment_samples", 500,
+                                            "fewest samples per closed segment"))
+        self._in_segment = 0
+        if not path:
+            raise LandingGearSimError("recorder needs the parameter bag:=FOLDER")
+        self._writer = SegmentedBagWriter(Path(path), TOPIC_TYPES, storage)
+        self._samples: dict[int, dict[str, bytes]] = {}
+        self._order: list[int] = []  # sample stamps in order (the wheel topic's arrival order)
+        self._currents: list[bytes] = []
+        self._written = 0
+        self._segment_start: int | None = None
+        self._end_seen_at: float | None = None
+        subscriptions = [self.subscription(kind, topic, self._callback(topic), DATA_QOS,
+                                           raw=True)
+                         for topic, kind in CONTRACT_KINDS.items()]
+        Handshake(self, {}, subscriptions, announce_ready(self))
+        self.get_logger().info(f"recording into {path} ({storage})")
+
+    def _callback(self, topic: str):
+        if topic == TOPIC_CURRENT:
+            return self._on_current
+
+        def on_sample(raw: bytes) -> None:
+            stamp = stamp_ns(raw)
+            if topic == TOPIC_WHEEL:
+                self._order.append(stamp)
+            self._samples.setdefault(stamp, {})[topic] = raw
+            self._flush()
+
+        return on_sample
+
+    def _on_current(self, raw: bytes) -> None:
+        self._currents.append(raw)
+        self._flush()
+
+    def _complete(self, index: int) -> bool:
+        messages = self._samples.get(self._order[index], {})
+        return len(messages) == len(SENSOR_TOPICS) and (index == 0 or len(self._currents) >= index)
+
+    def _flush(self, force: bool = False) -> None:
+        """Write every sample that is complete (or, forced or lagging, whatever it has)."""
+        while self._written < len(self._order):
+            index = self._written
+            lagging = len(self._order) - index > LAG_SAMPLES
+            if not (force or lagging or self._complete(index)):
+                return
+            self._write_sample(index)
+
+    def _write_sample(self, index: int) -> None:
+        stamp = self._order[index]
+        if self._segment_start is None:
+            self._segment_start = stamp
+        elif (stamp - self._segment_start >= self._segment_ns
+              and self._in_segment >= self._segment_samples):
+            self._writer.roll()
+            self._segment_start, self._in_segment = stamp, 0
+        self._in_segment += 1
+        if 0 < index <= len(self._currents):
+            self._writer.write(TOPIC_CURRENT, stamp, self._currents[index - 1])
+        messages = self._samples.pop(stamp, {})
+        for topic in SENSOR_TOPICS:
+            if topic in messages:
+                self._writer.write(topic, stamp, messages[topic])
+        self._written += 1
+
+    def pending(self) -> bool:
+        if self._end_seen_at is None:
+            self._end_seen_at = time.monotonic()
+        if self._written >= (self.run_samples or 0):
+            return False
+        if time.monotonic() - self._end_seen_at > END_GRACE_S:
+            self.get_logger().warning(f"run ended with {self.run_samples} samples; only "
+                                      f"{self._written} arrived complete in {END_GRACE_S:g} s")
+            return False
+        return True
+
+    def close(self) -> None:
+        self._flush(force=True)
+        self._writer.close()
+        self.get_logger().info(f"bag closed: {self._writer.path} ({self._written} samples, "
+                               f"{self._writer.message_count} messages)")
+
+
+main = main_for(RecorderNode)
+
+if __name__ == "__main__":
+    main()

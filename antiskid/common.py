@@ -5,9 +5,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .errors import ControllerError
+from landing_gear_sim.model.elements import GRAVITY_M_S2
 
-GRAVITY_M_S2 = 9.80665
+from .errors import ControllerError
 
 
 def check_positive(owner: str, **values: float) -> None:

@@ -6,7 +6,6 @@ for a measured run); everything else from the run's signals.
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -14,14 +13,22 @@ import scipy.integrate
 import scipy.signal
 
 from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.model.elements import slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.model.plant import rolling_radius_at
+from landing_gear_sim.model.quantities import (
+    gear_walk_modes,
+    peak_friction,
+    rim_speed_m_s,
+    rolling_radius_at,
+)
+from landing_gear_sim.model.scenario import brake_start_index
 from msg_tools.run import Run
+from msg_tools.units import PA_PER_BAR
 
 LOCK_SLIP = 0.95  # a wheel at 95 % slip or more is locked
 LOCK_MIN_SPEED_M_S = 5.0  # locks below this speed are the stop itself, not a skid
 MIN_LOAD_N = 1000.0  # below this the wheel is not on the flywheel: no friction to speak of
-CYCLE_PROMINENCE_PA = 2e5  # a pressure cycle is a peak standing 2 bar above its valleys
+CYCLE_PROMINENCE_PA = 2 * PA_PER_BAR  # a pressure cycle is a peak standing 2 bar above its valleys
 GEAR_WALK_BAND = 0.3  # cycling within ±30 % of the gear-walk frequency is flagged
 
 
@@ -47,40 +54,25 @@ class BrakingMetrics:
         return asdict(self)
 
 
-def peak_friction(rig: RigParameters) -> tuple[float, float]:
-    """Peak μ of the rig's friction curve and the slip where it occurs."""
-    t1, t2, t3 = (rig.number(f"friction.theta{i}") for i in (1, 2, 3))
-    slip = np.linspace(0.0, 1.0, 20001)
-    mu = t1 * (1.0 - np.exp(-t2 * slip)) - t3 * slip
-    best = int(np.argmax(mu))
-    return float(mu[best]), float(slip[best])
-
-
-def gear_walk_frequency_hz(rig: RigParameters) -> float:
-    inertia = rig.number("gear_walk.inertia_kg_m2")
-    return math.sqrt(rig.number("gear_walk.stiffness_n_m_per_rad") / inertia) / (2 * math.pi)
-
-
 def braking_window(run: Run) -> slice:
-    """From the first commanded current to the end of the run."""
-    active = np.flatnonzero(run.current_a > 1e-3)
-    if active.size == 0 or float(np.max(run.vertical_load_n)) < MIN_LOAD_N:
+    """From the first brake command (scenario.brake_start_index) to the end of the run."""
+    start = brake_start_index(run.current_a)
+    if start is None or float(np.max(run.vertical_load_n)) < MIN_LOAD_N:
         raise LandingGearSimError(f"{run.name}: not a braking run (no current, or the wheel "
                                   "never touches the flywheel)")
-    return slice(int(active[0]), len(run))
+    return slice(start, len(run))
 
 
 def speeds_m_s(run: Run, rig: RigParameters) -> tuple[np.ndarray, np.ndarray]:
     """Flywheel rim (vehicle) speed and wheel peripheral speed at the rolling radius [m/s]."""
-    vehicle = run.flywheel_speed_rad_s * rig.number("flywheel.radius_m")
+    vehicle = rim_speed_m_s(rig, run.flywheel_speed_rad_s)
     wheel = run.wheel_speed_rad_s * rolling_radius_at(rig, np.maximum(run.vertical_load_n, 0.0))
     return vehicle, wheel
 
 
 def slip_from(vehicle_m_s: np.ndarray, wheel_m_s: np.ndarray) -> np.ndarray:
-    """λ = (v − ωr)/v, 0 where the vehicle is (almost) at rest."""
-    return np.where(vehicle_m_s > 0.5, (vehicle_m_s - wheel_m_s) / np.maximum(vehicle_m_s, 0.5),
-                    0.0)
+    """λ of eq. (1) from the vehicle speed and the wheel's peripheral speed [m/s]."""
+    return slip_ratio(vehicle_m_s, wheel_m_s, 1.0)
 
 
 def braking_metrics(run: Run, rig: RigParameters) -> BrakingMetrics:
@@ -98,7 +90,7 @@ def braking_metrics(run: Run, rig: RigParameters) -> BrakingMetrics:
     locked = (slip >= LOCK_SLIP) & moving
     duration = float(t[-1] - t[0])
     cycles = _cycling_frequency(run.pressure_pa[window], duration)
-    gear_walk = gear_walk_frequency_hz(rig)
+    gear_walk, _ = gear_walk_modes(rig)
     return BrakingMetrics(
         stopping_distance_m=float(scipy.integrate.trapezoid(speed, t)),
         stopping_time_s=duration,

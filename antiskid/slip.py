@@ -20,6 +20,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from landing_gear_sim.model.elements import slip_ratio
+
 from .common import check_positive
 from .errors import ControllerError
 
@@ -88,7 +90,7 @@ def slip_step(params: SlipParams, state: SlipState, time_to_brake_s: float,
         state.integral_a = params.initial_current_a
     if speed < params.min_speed_m_s:  # slip is meaningless near standstill: hold
         return min(max(state.integral_a, 0.0), params.max_current_a)
-    state.slip = (speed - wheel_speed_rad_s * state.wheel_radius_m) / speed
+    state.slip = float(slip_ratio(speed, wheel_speed_rad_s, state.wheel_radius_m))
     error = params.slip_setpoint - state.slip  # > 0: room for more brake
     kp, ki = params.kp_per_m_s * speed, params.ki_per_m_s * speed
     candidate = state.integral_a + ki * error * state.step_s

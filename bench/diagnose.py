@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
-from landing_gear_sim.diagnosis.catalogue import simulate_all
+from landing_gear_sim.calibration.measured import simulate_all
 from landing_gear_sim.diagnosis.diagnose import diagnose
 from landing_gear_sim.model.parameters import RigParameters, load_parameters
 from msg_tools.io import read_campaign

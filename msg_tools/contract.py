@@ -5,7 +5,8 @@ CSV columns carry the units users read (bar); everything inside is SI (Pa).
 
 from __future__ import annotations
 
-PA_PER_BAR = 1e5
+from .units import PA_PER_BAR
+
 ATMOSPHERE_PA = 101325.0  # FluidPressure is absolute: gauge + 1 atm
 
 CSV_COLUMNS: tuple[str, ...] = (

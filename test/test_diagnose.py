@@ -13,7 +13,9 @@ import pytest
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.cli import main
 from landing_gear_sim.diagnosis.catalogue import CATALOGUE, gear_walk_key_parameters
-from landing_gear_sim.diagnosis.diagnose import DiagnosisError, diagnose, split_runs
+from landing_gear_sim.diagnosis.diagnose import diagnose
+from landing_gear_sim.diagnosis.scoring import split_runs
+from landing_gear_sim.errors import DiagnosisError
 from msg_tools.csv_io import read_csv, write_csv
 from msg_tools.io import read_campaign
 

@@ -9,8 +9,10 @@ import numpy as np
 import pytest
 
 from landing_gear_sim.calibration.campaign import DEVIATING, generate_campaign, rig_like
-from landing_gear_sim.calibration.identify import classify, identify
-from landing_gear_sim.calibration.validate import fit_percent, simulate_run, validate
+from landing_gear_sim.calibration.identify import identify
+from landing_gear_sim.calibration.measured import simulate_run
+from landing_gear_sim.calibration.runs import classify
+from landing_gear_sim.calibration.validate import fit_percent, validate
 from landing_gear_sim.cli import main
 from landing_gear_sim.model.parameters import load_parameters
 from msg_tools.io import read_campaign

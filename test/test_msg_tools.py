@@ -20,7 +20,7 @@ def run(reference):
                                "rig_test.max_duration_s": 4.0})
     scenario = sc.rig_test(noisy, sc.oscillating(**sc.OSC_LOW))
     result = simulate(noisy, scenario)
-    return result.to_run(noise_seed=7)
+    return result.to_run(noise=7)
 
 
 def test_csv_round_trip_is_exact(tmp_path, run):
@@ -56,7 +56,7 @@ def test_existing_bag_is_not_overwritten(tmp_path, run):
 def test_sensor_noise_follows_the_configured_std(reference):
     noisy = reference.replace({"sensors.pressure_noise_pa": 2e4})
     result = simulate(noisy, sc.actuator_test(noisy, sc.constant(0.5), 5.0))
-    clean, measured = result.pressure_pa, result.to_run(noise_seed=1).pressure_pa
+    clean, measured = result.pressure_pa, result.to_run(noise=1).pressure_pa
     assert np.std(measured - clean) == pytest.approx(2e4, rel=0.05)
     assert np.array_equal(result.to_run(1).pressure_pa, measured)  # seeded: reproducible
 

@@ -16,6 +16,7 @@ import pytest
 from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import load_parameters
 from landing_gear_sim.model.runspec import RunSpec, build_scenario
+from landing_gear_sim.ros.graph import load_scenario
 from landing_gear_sim.ros.launcher import ros_environment
 from msg_tools.bag_io import read_bag
 from msg_tools.csv_io import format_csv, write_csv
@@ -218,9 +219,9 @@ def test_rig_replay_reruns_a_logged_test_in_the_graph_as_offline(tmp_path):
     done = _run(_rig("--replay", str(tmp_path / "rig_log.csv"), "--bag", str(tmp_path / "bag")))
     assert done.returncode == 0, done.stderr[-3000:]
     params = load_parameters(overrides=SHORT)
-    rerun = simulate(params, build_scenario(RunSpec(profile="file",
-                                                    file=str(tmp_path / "rig_log.csv")),
-                                            params)).to_run()
+    rerun = simulate(params, load_scenario(RunSpec(profile="file",
+                                                   file=str(tmp_path / "rig_log.csv")),
+                                           params)).to_run()
     graph = read_bag(tmp_path / "bag")
     assert len(graph) == len(rerun)
     for field in FIELDS:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from landing_gear_sim.model import plant
+from landing_gear_sim.model import actuator, plant
 from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import run_kernel, simulate, simulate_batch
 from landing_gear_sim.model.parameters import load_parameters
@@ -126,17 +126,17 @@ def test_stepping_the_blocks_one_by_one_equals_the_compiled_run(reference):
     scenario = sc.rig_test(reference, sc.oscillating(**sc.OSC_LOW))
     current = scenario.current_a[:3000]
     p, h = reference.vector(), scenario.step_s
-    matrices = plant.actuator_matrices(p, h)
+    matrices = actuator.actuator_matrices(p, h)
     expected = np.empty((current.size, plant.N_CHANNELS))
     run_kernel(p, matrices, current, h, True, 60.0, 0.0, expected)
 
-    x, xa, xl = np.zeros(plant.N_STATES), plant.actuator_state(matrices), np.zeros(1)
+    x, xa, xl = np.zeros(plant.N_STATES), actuator.actuator_state(matrices), np.zeros(1)
     x[plant.SPEED] = 60.0
     work, rows = np.zeros((5, plant.N_STATES)), np.empty_like(expected)
     pressure = load = 0.0
     for k, i_k in enumerate(current):
         plant.record(p, x, k * h, i_k, pressure, load, rows[k])
-        next_pressure = plant.actuator_step(p, matrices, xa, i_k)
+        next_pressure = actuator.actuator_step(p, matrices, xa, i_k)
         next_load = plant.loading_step(p, xl, k * h, x[plant.SPEED], h)
         plant.plant_step(p, x, pressure, next_pressure, load, next_load, h, work)
         pressure, load = next_pressure, next_load

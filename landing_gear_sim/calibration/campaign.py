@@ -63,7 +63,7 @@ def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,
     for i, (name, scenario) in enumerate(standard_scenarios(rig).items()):
         if names is not None and name not in names:
             continue
-        run = simulate(rig, scenario).to_run(noise_seed=seed * 100 + i)
+        run = simulate(rig, scenario).to_run(noise=seed * 100 + i)
         path = folder / f"{name}.csv"
         write_csv(run, path)
         written.append(path)

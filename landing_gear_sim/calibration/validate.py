@@ -1,7 +1,9 @@
 """Simulate measured runs with their own inputs and score the model per channel.
 
 Fit % = 100·(1 − ‖y − ŷ‖/‖y − ȳ‖) on simulation (not one-step prediction), plus
-RMSE and maximum error, per contract channel.
+RMSE and maximum error, per contract channel. :func:`validate_campaign` also gathers
+what the validation report draws: the measured friction points and the actuator's
+measured frequency response beside the model's.
 """
 
 from __future__ import annotations
@@ -11,22 +13,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from landing_gear_sim.calibration.identify import brake_start_s, classify
-from landing_gear_sim.model.integrate import SimulationResult, simulate
+from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration.actuator import FrfEstimate, actuator_frf
+from landing_gear_sim.calibration.friction import friction_samples
+from landing_gear_sim.calibration.measured import channels_of, simulate_run
+from landing_gear_sim.calibration.runs import (
+    Family,
+    RunKind,
+    classified,
+    classify_all,
+    select,
+)
+from landing_gear_sim.model.integrate import SimulationResult
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.model.scenario import Scenario, logged_to_held
-from msg_tools.io import is_uniform, resample
 from msg_tools.run import Run
-
-CHANNELS: dict[str, str] = {
-    "pressure_pa": "brake pressure [Pa]",
-    "wheel_speed_rad_s": "wheel speed [rad/s]",
-    "flywheel_speed_rad_s": "flywheel speed [rad/s]",
-    "vertical_load_n": "vertical load [N]",
-    "longitudinal_force_n": "longitudinal force [N]",
-}
-ACTUATOR_CHANNELS = ("pressure_pa",)
-LOWEST_SIM_SPEED_M_S = 1.0  # below this slip is ill-defined; the rig stops at 3 m/s
 
 
 @dataclass(frozen=True)
@@ -44,9 +44,21 @@ class RunComparison:
 
     measured: Run
     simulated: Run
-    kind: str
+    kind: RunKind
     scores: dict[str, Score]
     result: SimulationResult | None = None
+
+
+@dataclass(frozen=True)
+class Validation:
+    """Everything a validation report shows: the comparisons, the measured (slip, μ)
+    points of the braking runs (None without braking runs), and the actuator's measured
+    FRF beside the model's for each dynamic actuator run."""
+
+    params: RigParameters
+    comparisons: list[RunComparison]
+    friction_points: tuple[np.ndarray, np.ndarray] | None
+    frf: list[FrfEstimate]
 
 
 def fit_percent(measured: np.ndarray, simulated: np.ndarray) -> float:
@@ -63,57 +75,31 @@ def score(measured: np.ndarray, simulated: np.ndarray) -> Score:
                  float(np.max(np.abs(error))))
 
 
-def scenario_for_run(run: Run, params: RigParameters) -> Scenario:
-    """The measured run's input as a scenario: its current, its initial speed, its timing."""
-    contact = not classify(run).startswith("actuator")
-    initial = float(np.mean(run.flywheel_speed_rad_s[:20])) * params.number("flywheel.radius_m")
-    return Scenario(run.name, logged_to_held(run.current_a), run.rate_hz, contact,
-                    initial if contact else 0.0, LOWEST_SIM_SPEED_M_S if contact else 0.0,
-                    "measured input")
-
-
-def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult]:
-    """Simulate ``run`` with its measured current; the result on the run's time base.
-
-    If the model stops (speed below 1 m/s) before the measurement ends, the last
-    simulated sample is held, so both have the same length, except the pressure: the
-    valve goes on following the measured current. The touch-down time is the run's
-    start, as in the rig procedure.
-    """
-    uniform = run if is_uniform(run, 1e-3) else resample(run, round(run.rate_hz))
-    result = simulate(params, scenario_for_run(uniform, params))
-    simulated = result.to_run()
-    n, m = len(uniform), len(simulated)
-    take = np.minimum(np.arange(n), m - 1)
-    fields = {name: getattr(simulated, name)[take] for name in CHANNELS}
-    if m < n:
-        fields["pressure_pa"] = result.sensed_pressure_to_end()[:n]
-    return Run(name=run.name, source="simulation", time_s=uniform.time_s,
-               current_a=uniform.current_a, **fields), result
-
-
-def compare(measured: Run, simulated: Run, kind: str | None = None) -> RunComparison:
+def compare(measured: Run, simulated: Run) -> RunComparison:
     """Score ``simulated`` against ``measured`` on their common samples."""
-    kind = kind or classify(measured)
-    n = min(len(measured), len(simulated))
-    channels = ACTUATOR_CHANNELS if kind.startswith("actuator") else tuple(CHANNELS)
-    scores = {c: score(getattr(measured, c)[:n], getattr(simulated, c)[:n]) for c in channels}
-    return RunComparison(measured, simulated, kind, scores)
+    run = classified(measured)
+    n = min(len(run), len(simulated))
+    scores = {c: score(getattr(run, c)[:n], getattr(simulated, c)[:n]) for c in channels_of(run)}
+    return RunComparison(measured, simulated, run.kind, scores)
 
 
 def validate(runs: Sequence[Run], params: RigParameters) -> list[RunComparison]:
     """Simulate every run with its measured input and score it."""
     out = []
-    for run in runs:
+    for run in classify_all(runs):
         simulated, result = simulate_run(run, params)
         comparison = compare(run, simulated)
         out.append(RunComparison(run, simulated, comparison.kind, comparison.scores, result))
     return out
 
 
-def braking_window(run: Run, params: RigParameters) -> np.ndarray:
-    """Samples from the brake application to where the rig is about to stop."""
-    t = run.time_s - run.time_s[0]
-    speed = run.flywheel_speed_rad_s * params.number("flywheel.radius_m")
-    return (t >= brake_start_s(run) - run.time_s[0]) & (
-        speed > params.number("rig_test.stop_speed_m_s") + 1.0)
+def validate_campaign(runs: Sequence[Run], params: RigParameters) -> Validation:
+    """:func:`validate`, with the friction points and the actuator FRFs of the campaign."""
+    classified_runs = classify_all(runs)
+    braking = select(classified_runs, [Family.BRAKE])
+    dynamic = select(classified_runs, [RunKind.ACTUATOR_DYNAMIC])
+    points = (friction_samples([br.prepare(r, params) for r in braking], params)
+              if braking else None)
+    return Validation(params, validate(classified_runs, params), points,
+                      [actuator_frf(r, params) for r in dynamic])
+

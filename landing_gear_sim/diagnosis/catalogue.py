@@ -17,10 +17,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from landing_gear_sim.calibration.identify import classify, covariance_std
-from landing_gear_sim.calibration.validate import simulate_run
+from landing_gear_sim.calibration.measured import simulate_all
+from landing_gear_sim.calibration.runs import Family, RunKind, Selector, classify_all, select
+from landing_gear_sim.calibration.statistics import covariance_std
+from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.quantities import gear_walk_modes
 from msg_tools.run import Run
+from msg_tools.units import PA_PER_BAR
 
 DECIMATE = 2  # residual samples kept (the simulation itself runs at the full rate)
 START_RATIO = 2.0  # multi-start: optimise only starts this close to the best initial cost
@@ -40,9 +44,8 @@ class Candidate:
         bounds: admissible range of each key.
         free: base-model parameters re-fitted with it (they could otherwise absorb
             or mask the effect).
-        runs: run kinds that carry its signature, fitted on: families ("actuator",
-            "brake") or classes ("brake_constant"; when the campaign has none, their
-            family).
+        runs: run kinds that carry its signature, fitted on: families or kinds
+            (when the campaign has none of a kind, its family).
         channels: measured channels compared.
         held_out: run kinds that also show the effect and are kept to check it (when
             empty, the fitting runs are split in two).
@@ -55,9 +58,9 @@ class Candidate:
     starts: tuple[tuple[float, ...], ...]
     bounds: tuple[tuple[float, float], ...]
     free: tuple[str, ...]
-    runs: tuple[str, ...]
+    runs: tuple[Selector, ...]
     channels: tuple[str, ...]
-    held_out: tuple[str, ...]
+    held_out: tuple[Selector, ...]
     contract: tuple[tuple[str, str], ...]
 
 
@@ -69,55 +72,58 @@ GEAR_WALK = ("gear_walk.stiffness_n_m_per_rad", "gear_walk.damping_n_m_s_per_rad
 PRESSURE = ("pressure_pa",)
 WHEEL = ("wheel_speed_rad_s", "longitudinal_force_n")
 FADE = ("brake.fade_fraction", "brake.fade_energy_j")
+ACTUATOR_RUNS: tuple[Selector, ...] = (Family.ACTUATOR,)
+BRAKE_RUNS: tuple[Selector, ...] = (Family.BRAKE,)
 
 CATALOGUE: dict[str, Candidate] = {c.cause: c for c in (
     # an actuator effect shows in every run's pressure: fitted on the actuator runs,
     # checked on the braking runs' pressure
     Candidate("actuator_delay", "actuator_delay", ("actuator.delay_s",),
               ((0.002,), (0.006,), (0.012,), (0.025,)), ((0.0, 0.06),), ACTUATOR,
-              ("actuator",), PRESSURE, ("brake",), (("delay_s", "actuator.delay_s"),)),
+              ACTUATOR_RUNS, PRESSURE, BRAKE_RUNS, (("delay_s", "actuator.delay_s"),)),
     # an offset shifts the whole map while calibrating it: re-fit the map with it; the
     # stretches below the dead-band tell the two apart
     Candidate("pressure_sensor_offset", "pressure_sensor_offset",
-              ("sensors.pressure_offset_pa",), ((0.0,),), ((-10e5, 10e5),), STATIC_MAP,
-              ("actuator",), PRESSURE, ("brake",),
+              ("sensors.pressure_offset_pa",), ((0.0,),),
+              ((-10 * PA_PER_BAR, 10 * PA_PER_BAR),), STATIC_MAP, ACTUATOR_RUNS, PRESSURE,
+              BRAKE_RUNS,
               (("offset_pa", "sensors.pressure_offset_pa"),)),
     Candidate("actuator_dynamics", "actuator_dynamics", ACTUATOR,
-              ((8.0, 0.5), (15.0, 0.8)), ((1.0, 60.0), (0.1, 2.0)), (), ("actuator",),
-              PRESSURE, ("brake",), (("natural_frequency_hz", ACTUATOR[0]),
+              ((8.0, 0.5), (15.0, 0.8)), ((1.0, 60.0), (0.1, 2.0)), (), ACTUATOR_RUNS,
+              PRESSURE, BRAKE_RUNS, (("natural_frequency_hz", ACTUATOR[0]),
                                      ("damping_ratio", ACTUATOR[1]))),
     # fitted on the constant-pressure stops: in the oscillating runs the wheel nears the
     # skid and the output error jumps with the exact moment (a fit there got stuck at
     # 2/3 of the true length, in a valley of width ~1 %)
     Candidate("tire_relaxation", "tire_relaxation", ("tyre.relaxation_length_m",),
-              ((0.1,), (0.4,), (1.0,)), ((0.005, 5.0),), FRICTION, ("brake_constant",), WHEEL,
-              (),
+              ((0.1,), (0.4,), (1.0,)), ((0.005, 5.0),), FRICTION, (RunKind.BRAKE_CONSTANT,),
+              WHEEL, (),
               (("relaxation_length_m", "tyre.relaxation_length_m"),)),
     Candidate("gear_walk", "gear_walk", GEAR_WALK,
               ((6.9e5, 1372.0), (3e5, 1000.0), (1.5e6, 2000.0)),
-              ((5e4, 2e7), (10.0, 5e4)), FRICTION, ("brake",), WHEEL, (), ()),
+              ((5e4, 2e7), (10.0, 5e4)), FRICTION, BRAKE_RUNS, WHEEL, (), ()),
     Candidate("brake_fade", "brake_fade", FADE, ((0.1, 2e6), (0.3, 5e5)),
               # the calibration bent the friction curve to absorb the fade: free it too
-              ((0.0, 0.9), (1e4, 1e8)), ("brake.gain_n_m_per_pa", *FRICTION), ("brake",),
+              ((0.0, 0.9), (1e4, 1e8)), ("brake.gain_n_m_per_pa", *FRICTION), BRAKE_RUNS,
               # the measured force is the brake torque over r whatever the friction
               # curve (which the calibration distorted to absorb the fade)
               ("longitudinal_force_n", "flywheel_speed_rad_s"), (),
               (("fade_fraction", FADE[0]), ("fade_energy_j", FADE[1]),
                ("gain_n_m_per_pa", "brake.gain_n_m_per_pa"))),
     Candidate("drag", "drag", ("drag.coeff_n_s2_per_m2",), ((0.2,),), ((0.0, 5.0),),
-              ("flywheel.inertia_kg_m2",), ("brake",), ("flywheel_speed_rad_s",), (),
+              ("flywheel.inertia_kg_m2",), BRAKE_RUNS, ("flywheel_speed_rad_s",), (),
               (("drag_coeff_n_s2_per_m2", "drag.coeff_n_s2_per_m2"),)),
     Candidate("load_dependent_radius", "load_dependent_radius",
               ("radius.a_m_per_n2", "radius.b_m_per_n"), ((4e-12, 5e-7),),
               # without the element the calibration bent the friction curve (slip read
               # with one radius at every load): free it too
               ((0.0, 1e-10), (0.0, 5e-6)),
-              ("wheel.unloaded_radius_m", "brake.gain_n_m_per_pa", *FRICTION), ("brake",),
+              ("wheel.unloaded_radius_m", "brake.gain_n_m_per_pa", *FRICTION), BRAKE_RUNS,
               WHEEL, (),
               (("radius_a_m_per_n2", "radius.a_m_per_n2"),
                ("radius_b_m_per_n", "radius.b_m_per_n"))),
     Candidate("friction_curve", None, FRICTION, (), ((0.05, 3.0), (1.0, 300.0), (0.0, 2.0)),
-              (), ("brake",), WHEEL, (), tuple((k.split(".")[1], k) for k in FRICTION)),
+              (), BRAKE_RUNS, WHEEL, (), tuple((k.split(".")[1], k) for k in FRICTION)),
 )}
 
 
@@ -149,19 +155,6 @@ def noise_std(values: np.ndarray) -> float:
 def noise_scales(runs: Sequence[Run], channels: Sequence[str]) -> Scales:
     """Noise std of every (run, channel), estimated from the measurement itself."""
     return {(r.name, c): noise_std(getattr(r, c)) for r in runs for c in channels}
-
-
-def select_runs(runs: Sequence[Run], kinds: Sequence[str]) -> list[Run]:
-    """Runs of one of ``kinds``: a family ("actuator", "brake") or a class
-    ("brake_constant", see identify.classify)."""
-    classes = [classify(r) for r in runs]  # classify reads the signals: once per run
-    return [r for r, c in zip(runs, classes, strict=True)
-            if c in kinds or c.split("_")[0] in kinds]
-
-
-def simulate_all(runs: Sequence[Run], params: RigParameters) -> list[Run]:
-    """Every run simulated with its measured input, on its own time base."""
-    return [simulate_run(run, params)[0] for run in runs]
 
 
 def scaled_error(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequence[str],
@@ -202,9 +195,9 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
     better in any campaign tried, and each optimisation costs seconds). ``null=True``
     fits the free parameters alone, element off: the fair reference for the candidate.
     """
-    chosen = select_runs(runs, candidate.runs)
+    chosen = select(classify_all(runs), candidate.runs)
     if not chosen:
-        raise ValueError(f"{candidate.cause}: no {'/'.join(candidate.runs)} run to fit on")
+        raise IdentificationError(f"{candidate.cause}: no {'/'.join(candidate.runs)} run to fit on")
     scales = scales or noise_scales(chosen, candidate.channels)
     own = () if null else candidate.keys
     model = base if null else switched_on(candidate, base)
@@ -284,9 +277,6 @@ def key_parameters(candidate: Candidate, params: RigParameters) -> dict[str, flo
 
 
 def gear_walk_key_parameters(params: RigParameters) -> dict[str, float]:
-    """frequency_hz = √(k_θ/J)/2π and damping_ratio = c_θ/(2√(k_θ J)), gear alone."""
-    k = params.number("gear_walk.stiffness_n_m_per_rad")
-    j = params.number("gear_walk.inertia_kg_m2")
-    c = params.number("gear_walk.damping_n_m_s_per_rad")
-    return {"frequency_hz": math.sqrt(k / j) / (2 * math.pi),
-            "damping_ratio": c / (2 * math.sqrt(k * j))}
+    """The gear-walk finding's contract parameters (see quantities.gear_walk_modes)."""
+    frequency_hz, damping_ratio = gear_walk_modes(params)
+    return {"frequency_hz": frequency_hz, "damping_ratio": damping_ratio}

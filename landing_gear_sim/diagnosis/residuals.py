@@ -6,15 +6,11 @@ reported only when it stands out of what noise alone would produce.
 * spectrum peaks: Welch PSD against a running-median noise floor; a bin over the
   floor is F-distributed (Welch's equivalent dof for the bin, the median's for
   the floor), tested at a family-wise level over all bins (Bonferroni);
-* coherence with an input at a peak, against the K-segment null threshold
-  1 − α^{1/(K−1)};
-* whiteness: normalised autocorrelation with ±z/√N bands and the Ljung-Box Q;
-* input–residual cross-correlation with the same bands;
+* normalised autocorrelation with ±z/√N bands for white residuals;
 * lag between a measured and a simulated signal: cross-correlation of their
   derivatives, refined between samples by a parabola;
 * correlation with candidate regressors, using the effective sample count of
-  two autocorrelated series (Bartlett);
-* RMS of the residual per phase of the run.
+  two autocorrelated series (Bartlett).
 """
 
 from __future__ import annotations
@@ -79,16 +75,6 @@ def spectrum(residual: np.ndarray, rate_hz: float, segment: int = 2048,
     return Spectrum(f, psd, floor, threshold, tuple(peaks))
 
 
-def coherence_at(residual: np.ndarray, signal: np.ndarray, rate_hz: float,
-                 frequency_hz: float, segment: int = 2048) -> tuple[float, float]:
-    """(coherence, null threshold) between ``residual`` and ``signal`` at a frequency."""
-    nperseg = min(segment, len(residual))
-    f, coherence = scipy.signal.coherence(residual, signal, rate_hz, nperseg=nperseg)
-    segments = max(2, 2 * len(residual) // nperseg - 1)
-    threshold = 1.0 - FALSE_ALARM ** (1.0 / (segments - 1))
-    return float(coherence[np.argmin(np.abs(f - frequency_hz))]), float(threshold)
-
-
 @dataclass(frozen=True)
 class Correlation:
     """Normalised correlation at lags 0..max (or −max..max), and its ±band (noise only)."""
@@ -110,30 +96,6 @@ def autocorrelation(residual: np.ndarray, max_lag: int) -> Correlation:
     n = x.size
     full = scipy.signal.correlate(x, x, mode="full", method="fft")[n - 1: n + max_lag] / (x @ x)
     return Correlation(np.arange(max_lag + 1), full, _band(n))
-
-
-def ljung_box(residual: np.ndarray, max_lag: int) -> tuple[float, float]:
-    """Ljung-Box Q over lags 1..max_lag and its p-value (small p: not white)."""
-    rho = autocorrelation(residual, max_lag).values[1:]
-    n = len(residual)
-    q = n * (n + 2) * float(np.sum(rho ** 2 / (n - np.arange(1, max_lag + 1))))
-    return q, float(scipy.stats.chi2.sf(q, max_lag))
-
-
-def cross_correlation(signal: np.ndarray, residual: np.ndarray, max_lag: int) -> Correlation:
-    """Normalised cross-correlation r(τ) = Σ u(t) e(t+τ), τ in −max..max.
-
-    The ±z/√N band holds when one of the two is white; prewhiten the input
-    otherwise (a smooth input makes neighbouring lags correlated).
-    """
-    u = np.asarray(signal, dtype=float) - np.mean(signal)
-    e = np.asarray(residual, dtype=float) - np.mean(residual)
-    n = u.size
-    full = scipy.signal.correlate(e, u, mode="full", method="fft")
-    centre = n - 1
-    lags = np.arange(-max_lag, max_lag + 1)
-    values = full[centre + lags] / np.sqrt((u @ u) * (e @ e))
-    return Correlation(lags, values, _band(n))
 
 
 def _band(n: int) -> float:
@@ -194,25 +156,3 @@ def regressor_correlations(residual: np.ndarray, candidates: Mapping[str, np.nda
         n_eff = effective_samples(residual, signal)
         out.append(RegressorCorrelation(name, value, _band(int(n_eff))))
     return sorted(out, key=lambda c: -abs(c.value) / c.band)
-
-
-def rms_by_phase(residual: np.ndarray, phases: Mapping[str, np.ndarray]) -> dict[str, float]:
-    """RMS of the residual over each phase mask (phases with no sample are left out)."""
-    return {name: float(np.sqrt(np.mean(residual[mask] ** 2)))
-            for name, mask in phases.items() if np.any(mask)}
-
-
-def run_phases(time_s: np.ndarray, pressure_pa: np.ndarray, speed_m_s: np.ndarray,
-               brake_start_s: float, rate_hz: float) -> dict[str, np.ndarray]:
-    """Masks of the phases of a rig test: touch-down, pressure rise, release, low speed,
-    steady braking."""
-    t = time_s - time_s[0]
-    smooth = scipy.ndimage.uniform_filter1d(pressure_pa, max(int(0.01 * rate_hz), 1))
-    rate = np.gradient(smooth, 1.0 / rate_hz)
-    braking = t >= brake_start_s
-    rising = braking & (rate > 20e5)  # > 20 bar/s
-    releasing = braking & (rate < -20e5)
-    low = braking & (speed_m_s < 10.0)
-    return {"touch-down": t < brake_start_s, "pressure rise": rising & ~low,
-            "release": releasing & ~low, "low speed": low,
-            "steady braking": braking & ~rising & ~releasing & ~low}

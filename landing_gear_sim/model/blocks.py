@@ -11,9 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from landing_gear_sim.model import plant
+from landing_gear_sim.model import actuator, plant, quantities
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.scenario import Scenario
+from landing_gear_sim.model.sensors import SensorModel
 
 
 @dataclass(frozen=True)
@@ -39,12 +40,12 @@ class ActuatorBlock:
 
     def __init__(self, params: RigParameters, step_s: float) -> None:
         self._p = params.vector()
-        self._matrices = plant.actuator_matrices(self._p, step_s)
-        self._state = plant.actuator_state(self._matrices)
+        self._matrices = actuator.actuator_matrices(self._p, step_s)
+        self._state = actuator.actuator_state(self._matrices)
 
     def step(self, current_a: float) -> float:
         """Pressure applied to the brake at the end of the step [Pa, gauge]."""
-        return float(plant.actuator_step(self._p, self._matrices, self._state, current_a))
+        return float(actuator.actuator_step(self._p, self._matrices, self._state, current_a))
 
 
 class LoadingBlock:
@@ -54,14 +55,14 @@ class LoadingBlock:
         self._p = params.vector()
         self._step_s = step_s
         self._contact = contact
-        self._flywheel_radius_m = params.number("flywheel.radius_m")
+        self._params = params
         self._state = np.zeros(1)
 
     def step(self, step: int, flywheel_speed_rad_s: float) -> float:
         """Vertical force at the end of step ``step`` [N] (0 when the wheel is off)."""
         if not self._contact:
             return 0.0
-        speed = flywheel_speed_rad_s * self._flywheel_radius_m
+        speed = quantities.rim_speed_m_s(self._params, flywheel_speed_rad_s)
         t = step_time(step, self._step_s)
         return float(plant.loading_step(self._p, self._state, t, speed, self._step_s))
 
@@ -82,11 +83,8 @@ class PlantBlock:
         self._x[plant.SPEED] = scenario.initial_speed_m_s if scenario.contact else 0.0
         self._work = np.zeros((5, plant.N_STATES))
         self._row = np.empty(plant.N_CHANNELS)
-        self._flywheel_radius_m = params.number("flywheel.radius_m")
-        self._offset_pa = (params.number("sensors.pressure_offset_pa")
-                           if params.has("pressure_sensor_offset") else 0.0)
-        self._noise_std = {key: params.number(f"sensors.{key}")
-                           for key in ("pressure_noise_pa", "speed_noise_rad_s", "force_noise_n")}
+        self._params = params
+        self._sensors = SensorModel.of(params)
         self.step_index = 0
         self.pressure_pa = 0.0
         self.load_n = 0.0
@@ -115,14 +113,15 @@ class PlantBlock:
     def sample(self) -> SensorSample:
         """Sensor readings of the current sample."""
         row = self.record()
+        sensors, rng = self._sensors, self._noise
         return SensorSample(
             step=self.step_index, time_s=float(row[0]),
-            pressure_pa=self._sensed(row[2] + self._offset_pa, "pressure_noise_pa"),
-            wheel_speed_rad_s=self._sensed(row[3], "speed_noise_rad_s"),
-            flywheel_speed_rad_s=self._sensed(row[4] / self._flywheel_radius_m,
-                                              "speed_noise_rad_s"),
-            vertical_load_n=self._sensed(row[6], "force_noise_n"),
-            longitudinal_force_n=self._sensed(row[7], "force_noise_n"))
+            pressure_pa=float(sensors.pressure(row[2], rng)),
+            wheel_speed_rad_s=float(sensors.speed(row[3], rng)),
+            flywheel_speed_rad_s=float(sensors.speed(
+                quantities.flywheel_speed_rad_s(self._params, row[4]), rng)),
+            vertical_load_n=float(sensors.force(row[6], rng)),
+            longitudinal_force_n=float(sensors.force(row[7], rng)))
 
     def advance(self, next_pressure_pa: float, next_load_n: float) -> None:
         """Integrate to the next sample with inputs ramping to the given end values."""
@@ -130,9 +129,3 @@ class PlantBlock:
                          next_load_n, self.step_s, self._work)
         self.pressure_pa, self.load_n = next_pressure_pa, next_load_n
         self.step_index += 1
-
-    def _sensed(self, value: float, key: str) -> float:
-        std = self._noise_std[key]
-        if self._noise is None or std <= 0.0:
-            return float(value)
-        return float(value + self._noise.normal(0.0, std))

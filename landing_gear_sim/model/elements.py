@@ -1,15 +1,19 @@
-"""Model elements: one physical law each, compiled with numba.
+"""Model elements: one physical law each, compiled with numba. Each law is written here once.
 
-Every function takes the packed parameter vector ``p`` (see
-:mod:`landing_gear_sim.model.parameters`) and SI quantities, and is pure. The plant
+The laws with explicit coefficients (:func:`burckhardt_mu`, :func:`slip_ratio`,
+:func:`valve_map`, :func:`fade_factor`) take floats or numpy arrays alike — the same
+compiled definition serves the plant's scalar loop and the array code of calibration,
+metrics and plots. They are inlined into their callers (``inline="always"``): as separate
+calls they made the plant's RK4 loop 24 % slower. The others take the packed parameter vector ``p`` (see
+:mod:`landing_gear_sim.model.parameters`) and SI quantities, and are pure. The plant
 (:mod:`landing_gear_sim.model.plant`) composes them; a switchable element is skipped
 when its ``elements.<name>`` flag is 0. Equation numbers refer to the paper.
+:mod:`landing_gear_sim.model.quantities` evaluates them on arrays for a parameter set.
 """
 
 from __future__ import annotations
 
-import math
-
+import numpy as np
 from numba import njit
 
 from landing_gear_sim.model.parameters import INDEX
@@ -60,11 +64,17 @@ TOUCHDOWN_RAMP = INDEX["loading.touchdown_ramp_s"]
 TOUCHDOWN_T = INDEX["rig_test.touchdown_s"]
 
 
+@njit(cache=True, inline="always")
+def burckhardt_mu(theta1, theta2, theta3, slip):
+    """Burckhardt friction coefficient μ = ϑ1 (1 − e^{−ϑ2 λ}) − ϑ3 λ, eq. (11), for λ ≥ 0."""
+    return theta1 * (1.0 - np.exp(-theta2 * slip)) - theta3 * slip
+
+
 @njit(cache=True)
 def burckhardt(p, slip):
-    """Friction coefficient μ(λ), eq. (11), extended odd for λ < 0 (wheel faster than hub)."""
-    s = abs(slip)
-    mu = p[THETA1] * (1.0 - math.exp(-p[THETA2] * s)) - p[THETA3] * s
+    """Friction coefficient μ(λ) of the parameter set, extended odd for λ < 0 (wheel faster
+    than hub)."""
+    mu = burckhardt_mu(p[THETA1], p[THETA2], p[THETA3], abs(slip))
     return mu if slip >= 0.0 else -mu
 
 
@@ -83,23 +93,29 @@ def rolling_radius(p, vertical_load_n):
     return p[R0] - (p[RADIUS_A] * fz * fz + p[RADIUS_B] * fz + p[RADIUS_C])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def slip_ratio(hub_speed_m_s, wheel_speed_rad_s, radius_m):
-    """Longitudinal slip λ = (v_h − ω r)/v_h, eq. (1)."""
-    vh = max(hub_speed_m_s, MIN_HUB_SPEED_M_S)
+    """Longitudinal slip λ = (v_h − ω r)/v_h, eq. (1); v_h floored at MIN_HUB_SPEED_M_S."""
+    vh = np.maximum(hub_speed_m_s, MIN_HUB_SPEED_M_S)
     return (vh - wheel_speed_rad_s * radius_m) / vh
+
+
+@njit(cache=True, inline="always")
+def fade_factor(fade_fraction, brake_energy_j, fade_energy_j):
+    """Share of the brake gain left after absorbing ``brake_energy_j``:
+    1 − φ (1 − e^{−E/E_f}) (the ``brake_fade`` element)."""
+    return 1.0 - fade_fraction * (1.0 - np.exp(-brake_energy_j / fade_energy_j))
 
 
 @njit(cache=True)
 def brake_torque(p, pressure_pa, brake_energy_j):
     """Brake torque T_b = k_b P_b, eq. (8); a brake cannot push, so P_b < 0 gives 0.
 
-    With ``brake_fade`` the gain falls as the brake heats:
-    k_b (1 − φ (1 − e^{−E/E_f})), E the energy the brake has absorbed.
+    With ``brake_fade`` the gain falls as the brake heats: k_b·:func:`fade_factor`.
     """
     gain = p[BRAKE_GAIN]
     if p[HAS_FADE]:
-        gain *= 1.0 - p[FADE_FRACTION] * (1.0 - math.exp(-brake_energy_j / p[FADE_ENERGY]))
+        gain *= fade_factor(p[FADE_FRACTION], brake_energy_j, p[FADE_ENERGY])
     return gain * max(pressure_pa, 0.0)
 
 
@@ -148,12 +164,20 @@ def translational_mass(p):
     return p[AC_MASS] + p[AC_WHEEL_MASS] + p[AC_GEAR_MASS]
 
 
+@njit(cache=True, inline="always")
+def valve_map(current_a, max_current_a, deadband_a, k1_pa_per_a, k2_pa_per_a2, max_pressure_pa):
+    """Static current→pressure map P = k1 (I−I0) + k2 (I−I0)², I within [0, I_max],
+    dead-band I0, saturation P_max [Pa]."""
+    current = np.minimum(np.maximum(current_a, 0.0), max_current_a)
+    excess = np.maximum(current - deadband_a, 0.0)
+    return np.minimum(k1_pa_per_a * excess + k2_pa_per_a2 * excess * excess, max_pressure_pa)
+
+
 @njit(cache=True)
 def valve_static_pressure(p, current_a):
-    """Static current→pressure map P = k1 (I−I0) + k2 (I−I0)², dead-band and saturation."""
-    current = min(max(current_a, 0.0), p[MAX_CURRENT])
-    excess = max(current - p[DEADBAND], 0.0)
-    return min(p[MAP_K1] * excess + p[MAP_K2] * excess * excess, p[MAX_PRESSURE])
+    """The valve's static-map pressure [Pa] of the parameter set at ``current_a`` [A]."""
+    return valve_map(current_a, p[MAX_CURRENT], p[DEADBAND], p[MAP_K1], p[MAP_K2],
+                     p[MAX_PRESSURE])
 
 
 @njit(cache=True)

@@ -13,20 +13,20 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, prange
 
+from landing_gear_sim.model.actuator import actuator_matrices, actuator_state, actuator_step
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.plant import (
     CHANNELS,
     N_CHANNELS,
     N_STATES,
     SPEED,
-    actuator_matrices,
-    actuator_state,
-    actuator_step,
     loading_step,
     plant_step,
     record,
 )
+from landing_gear_sim.model.quantities import flywheel_speed_rad_s
 from landing_gear_sim.model.scenario import Scenario, held_to_logged
+from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.run import Run
 
 STOP_REASONS = ("end of input", "stop speed reached")
@@ -95,11 +95,6 @@ class SimulationResult:
     def __len__(self) -> int:
         return int(self.data.shape[0])
 
-    def _pressure_offset_pa(self) -> float:
-        if not self.params.has("pressure_sensor_offset"):
-            return 0.0
-        return self.params.number("sensors.pressure_offset_pa")
-
     def sensed_pressure_to_end(self) -> np.ndarray:
         """Brake pressure as the transducer reads it (offset, no noise) over the whole
         input, (n,) [Pa]: after a stop at the stop speed the valve still follows its
@@ -108,32 +103,26 @@ class SimulationResult:
         pressure = np.empty(self.scenario.current_a.size)
         actuator_kernel(vector, actuator_matrices(vector, self.scenario.step_s),
                         self.scenario.current_a, pressure)
-        return pressure + self._pressure_offset_pa()
+        return SensorModel.of(self.params).pressure(pressure)
 
-    def to_run(self, noise_seed: int | None = None) -> Run:
-        """The run as the rig's sensors would log it (data contract), with sensor noise.
+    def to_run(self, noise: np.random.Generator | int | None = None) -> Run:
+        """The run as the rig's sensors would log it (data contract).
 
-        Noise std comes from ``sensors.*``; ``noise_seed`` makes it reproducible. The
-        pressure transducer reads ``sensors.pressure_offset_pa`` high when the
-        ``pressure_sensor_offset`` element is on.
+        The sensors are those of :class:`~landing_gear_sim.model.sensors.SensorModel`:
+        the pressure offset when its element is on, and the ``sensors.*`` noise only when
+        ``noise`` (a generator, or a seed for a reproducible one) is given.
         """
-        rng = np.random.default_rng(noise_seed)
-        p = self.params
-
-        def sensed(values: np.ndarray, std_key: str) -> np.ndarray:
-            std = p.number(std_key)
-            return values + rng.normal(0.0, std, values.shape) if std > 0 else values.copy()
-
+        rng = None if noise is None else np.random.default_rng(noise)
+        sensors = SensorModel.of(self.params)
         return Run(
             name=self.scenario.name, source="simulation", time_s=self.time_s.copy(),
             current_a=held_to_logged(self.current_a),
-            pressure_pa=sensed(self.pressure_pa + self._pressure_offset_pa(),
-                               "sensors.pressure_noise_pa"),
-            wheel_speed_rad_s=sensed(self.wheel_speed_rad_s, "sensors.speed_noise_rad_s"),
-            flywheel_speed_rad_s=sensed(self.speed_m_s / p.number("flywheel.radius_m"),
-                                        "sensors.speed_noise_rad_s"),
-            vertical_load_n=sensed(self.vertical_load_n, "sensors.force_noise_n"),
-            longitudinal_force_n=sensed(self.longitudinal_force_n, "sensors.force_noise_n"),
+            pressure_pa=sensors.pressure(self.pressure_pa, rng),
+            wheel_speed_rad_s=sensors.speed(self.wheel_speed_rad_s, rng),
+            flywheel_speed_rad_s=sensors.speed(flywheel_speed_rad_s(self.params, self.speed_m_s),
+                                               rng),
+            vertical_load_n=sensors.force(self.vertical_load_n, rng),
+            longitudinal_force_n=sensors.force(self.longitudinal_force_n, rng),
         )
 
 

@@ -1,4 +1,5 @@
-"""The rig plant composed from its elements, and the step functions of each block.
+"""The rig plant composed from its elements, and the step functions of the plant and
+the loading device (the actuator's are in :mod:`landing_gear_sim.model.actuator`).
 
 Three blocks exchange values once per output step ``h`` (the same cut as the
 ROS graph: actuator node, loading-device node, plant node):
@@ -25,12 +26,9 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-import scipy.linalg
 from numba import njit
 
 from landing_gear_sim.model import elements as el
-from landing_gear_sim.model.parameters import INDEX, RigParameters
 
 SPEED, ANGLE, ANGLE_RATE, OMEGA, E_BRAKE, E_DRAG, E_SLIP, E_DAMP, TYRE_FORCE = range(9)
 N_STATES = 9
@@ -47,11 +45,6 @@ CHANNELS: tuple[str, ...] = (
 )
 """Columns of a simulation record, in order (SI; slip and η dimensionless)."""
 N_CHANNELS = len(CHANNELS)
-
-_ACT_GAIN = INDEX["actuator.gain"]
-_ACT_WN = INDEX["actuator.natural_frequency_hz"]
-_ACT_ZETA = INDEX["actuator.damping_ratio"]
-_ACT_DELAY = INDEX["actuator.delay_s"]
 
 
 @njit(cache=True)
@@ -98,13 +91,6 @@ def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     dx[TYRE_FORCE] = el.relaxation_rate(p, hub) * (steady - x[TYRE_FORCE])
 
 
-def rolling_radius_at(params: RigParameters, load_n: np.ndarray) -> np.ndarray:
-    """Rolling radius of eq. (9) at each vertical load [N] → [m], same shape; r0 when the
-    ``load_dependent_radius`` element is off. The compiled law itself, once per sample."""
-    vector = params.vector()
-    return np.array([el.rolling_radius(vector, f) for f in np.asarray(load_n, dtype=float)])
-
-
 @njit(cache=True)
 def substep_count(p, x, step_s, max_load_n):
     """Substeps for one exchange step: ≤ MAX_SUBSTEP_S and stable for the stiffest mode."""
@@ -148,67 +134,6 @@ def plant_step(p, x, pressure0, pressure1, load0, load1, step_s, work):
             x[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
         if x[OMEGA] < 0.0:  # the wheel locks; it never turns backwards
             x[OMEGA] = 0.0
-
-
-def _zoh(a: np.ndarray, b: np.ndarray, span_s: float) -> tuple[np.ndarray, np.ndarray]:
-    """Φ = e^{A T}, Γ = ∫₀ᵀ e^{A s} ds B for an input held over ``span_s``."""
-    augmented = np.zeros((3, 3))
-    augmented[:2, :2], augmented[:2, 2] = a, b
-    m = scipy.linalg.expm(augmented * span_s)
-    return m[:2, :2], m[:2, 2]
-
-
-ACT_DELAY_STEPS = 8  # position of the whole-step delay in the actuator matrices
-
-
-def actuator_matrices(params_vector: np.ndarray, step_s: float) -> np.ndarray:
-    """Exact discretisation of A(s) with the held input delayed by ``actuator.delay_s``.
-
-    With the delay d = (m + f)·h, the input seen over step k is u_{k−m−1} for f·h,
-    then u_{k−m} for (1−f)·h, so x_{k+1} = Φ_h x_k + G0 u_{k−m} + G1 u_{k−m−1} with
-    G0 = Γ_{(1−f)h} and G1 = Φ_{(1−f)h} Γ_{fh}. Returns
-    ``[Φ00, Φ01, Φ10, Φ11, G0₀, G0₁, G1₀, G1₁, m]`` for the state (pressure [Pa],
-    rate [Pa/s]) driven by the static-map pressure.
-    """
-    p = params_vector
-    wn = 2.0 * math.pi * p[_ACT_WN]
-    a = np.array([[0.0, 1.0], [-wn * wn, -2.0 * p[_ACT_ZETA] * wn]])
-    b = np.array([0.0, p[_ACT_GAIN] * wn * wn])
-    delay = p[_ACT_DELAY] if p[el.HAS_ACTUATOR_DELAY] else 0.0
-    steps = delay / step_s
-    whole = math.floor(steps + 1e-9)
-    fraction = steps - whole if steps - whole > 1e-9 else 0.0
-    phi, gamma = _zoh(a, b, step_s)
-    if fraction == 0.0:
-        g0, g1 = gamma, np.zeros(2)
-    else:
-        phi_late, g0 = _zoh(a, b, (1.0 - fraction) * step_s)
-        g1 = phi_late @ _zoh(a, b, fraction * step_s)[1]
-    return np.concatenate([phi.ravel(), g0, g1, [float(whole)]])
-
-
-@njit(cache=True)
-def actuator_state(matrices):
-    """Zero actuator state: pressure, rate, then the static pressures of recent steps."""
-    return np.zeros(2 + int(matrices[ACT_DELAY_STEPS]) + 2)
-
-
-@njit(cache=True)
-def actuator_step(p, matrices, xa, current_a):
-    """Advance the actuator state ``xa`` one step with ``current_a`` held; return P [Pa]."""
-    for j in range(xa.size - 1, 2, -1):  # shift register of static-map pressures
-        xa[j] = xa[j - 1]
-    xa[2] = el.valve_static_pressure(p, current_a)
-    whole = int(matrices[ACT_DELAY_STEPS])
-    newer, older = xa[2 + whole], xa[3 + whole]
-    if p[el.HAS_ACTUATOR_DYNAMICS] == 0.0:
-        xa[0], xa[1] = p[_ACT_GAIN] * newer, 0.0
-        return xa[0]
-    m = matrices
-    x0, x1 = xa[0], xa[1]
-    xa[0] = m[0] * x0 + m[1] * x1 + m[4] * newer + m[6] * older
-    xa[1] = m[2] * x0 + m[3] * x1 + m[5] * newer + m[7] * older
-    return xa[0]
 
 
 @njit(cache=True)

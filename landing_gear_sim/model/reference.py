@@ -3,9 +3,10 @@
 The continuous-time model (plant + actuator A(s) + loading servo, one state
 vector) is integrated with ``scipy.integrate.solve_ivp`` (Radau, implicit) piece
 by piece between the instants where the held current changes. It shares the
-element functions with the fast integrator, so a difference between the two is
-integration error, not a different model. The wheel-lock clamp is not modelled:
-use it on runs that do not lock.
+element functions and A(s) with the fast integrator, so a difference between the two
+is integration error, not a different model. It refuses parameter sets with elements it
+does not model (a transport delay, a static actuator); the wheel-lock clamp is not
+modelled either: use it on runs that do not lock.
 """
 
 from __future__ import annotations
@@ -15,7 +16,9 @@ from itertools import pairwise
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from landing_gear_sim.errors import ParameterError
 from landing_gear_sim.model import elements as el
+from landing_gear_sim.model.actuator import actuator_system
 from landing_gear_sim.model.parameters import INDEX, RigParameters
 from landing_gear_sim.model.plant import (
     ANGLE,
@@ -40,9 +43,10 @@ def reference_solution(params: RigParameters, scenario: Scenario, end_s: float |
     Returns ``time_s``, ``wheel_speed_rad_s``, ``speed_m_s`` and ``pressure_pa``
     at the scenario's sample instants.
     """
+    _check_modelled(params)
     p = params.vector()
-    wn = 2 * np.pi * p[INDEX["actuator.natural_frequency_hz"]]
-    zeta, gain = p[INDEX["actuator.damping_ratio"]], p[INDEX["actuator.gain"]]
+    act_a, act_b = actuator_system(params)
+    wn = 2 * np.pi * params.number("actuator.natural_frequency_hz")
     tau = p[INDEX["loading.servo_time_constant_s"]]
     x, dx = np.zeros(N_STATES), np.zeros(N_STATES)
     p_max = p[INDEX["actuator.max_pressure_pa"]]
@@ -56,7 +60,7 @@ def reference_solution(params: RigParameters, scenario: Scenario, end_s: float |
         dynamic, scales = [*dynamic, TYRE_FORCE], [*scales, load]
     if params.has("brake_fade"):
         dynamic, scales = [*dynamic, E_BRAKE], [*scales, 1e7]
-    pressure_i, rate_i, load_i = len(dynamic), len(dynamic) + 1, len(dynamic) + 2
+    pressure_i, load_i = len(dynamic), len(dynamic) + 2  # pressure, its rate, the load
     scale = np.array([*scales, p_max, wn * p_max, load])
 
     def rhs(t: float, y: np.ndarray, current: float) -> np.ndarray:
@@ -66,8 +70,7 @@ def reference_solution(params: RigParameters, scenario: Scenario, end_s: float |
         derivatives(p, x, y[pressure_i], vertical, dx)
         out = np.empty_like(y)
         out[:pressure_i] = dx[dynamic]
-        out[pressure_i] = y[rate_i]
-        out[rate_i] = wn * wn * (gain * static - y[pressure_i]) - 2 * zeta * wn * y[rate_i]
+        out[pressure_i:load_i] = act_a @ y[pressure_i:load_i] + act_b * static
         reference = el.vertical_load_reference(p, t, y[0]) if scenario.contact else 0.0
         out[load_i] = (reference - y[load_i]) / tau
         return out
@@ -87,3 +90,16 @@ def reference_solution(params: RigParameters, scenario: Scenario, end_s: float |
         y = sol.y[:, -1]
     return {"time_s": times, "wheel_speed_rad_s": samples[:, 3],
             "speed_m_s": samples[:, 0], "pressure_pa": samples[:, pressure_i]}
+
+
+UNMODELLED = {"actuator_delay": True, "actuator_dynamics": False}
+"""Element switches the reference cannot follow: with this value it would silently
+solve another model."""
+
+
+def _check_modelled(params: RigParameters) -> None:
+    for element, unsupported in UNMODELLED.items():
+        if params.has(element) == unsupported:
+            state = "on" if unsupported else "off"
+            raise ParameterError(f"the reference solution does not model elements.{element} "
+                                 f"{state}; compare without it")

@@ -16,6 +16,8 @@ from pathlib import Path
 from landing_gear_sim.errors import ScenarioError
 from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.parameters import RigParameters
+from msg_tools.run import Run
+from msg_tools.units import PA_PER_BAR
 
 CONTACT_CHOICES = ("auto", "rig", "actuator")
 """``auto``: the profile's own test (braking profiles on the flywheel, actuator
@@ -38,7 +40,7 @@ class RunSpec:
     """
 
     profile: str = "constant"
-    pressure_pa: float = 30e5
+    pressure_pa: float = 30 * PA_PER_BAR
     current_a: float = math.nan
     file: str = ""
     contact: str = "auto"
@@ -57,12 +59,17 @@ class RunSpec:
             raise ScenarioError("duration and rate must be >= 0 (0 = default)")
 
     @property
+    def replays_file(self) -> bool:
+        """The current comes from a recorded run (``file``), which the caller reads."""
+        return self.profile == "file"
+
+    @property
     def name(self) -> str:
         if self.profile == "file":
             return Path(self.file).stem + "_sim"
         if self.profile == "constant":
             if math.isnan(self.current_a):
-                return f"brake_const_{self.pressure_pa / 1e5:g}bar"
+                return f"brake_const_{self.pressure_pa / PA_PER_BAR:g}bar"
             return f"brake_const_{self.current_a:g}A"
         return self.profile.replace("-", "_")
 
@@ -88,18 +95,22 @@ PROFILES: dict[str, tuple[Builder, bool, float]] = {
 }
 
 
-def build_scenario(spec: RunSpec, params: RigParameters) -> sc.Scenario:
-    """The scenario of ``spec`` under ``params``.
+def build_scenario(spec: RunSpec, params: RigParameters, recorded: Run | None = None
+                   ) -> sc.Scenario:
+    """The scenario of ``spec`` under ``params``; ``recorded`` is the run of the ``file``
+    profile (read from ``spec.file`` by the caller: the model reads no files).
 
     Raises:
-        ScenarioError: the profile cannot be built (e.g. a pressure outside the valve range).
-        msg_tools.errors.RunFormatError: the ``file`` profile's run is unreadable.
+        ScenarioError: the profile cannot be built (e.g. a pressure outside the valve range,
+            a ``file`` profile without its recorded run).
     """
     rate = spec.rate_hz or None
     if spec.profile == "external":
         return sc.rig_test(params, sc.constant(0.0), "external", rate)
     if spec.profile == "file":
-        profile, duration = sc.from_file(Path(spec.file))
+        if recorded is None:
+            raise ScenarioError(f"profile 'file' needs the recorded run of {spec.file!r}")
+        profile, duration = sc.from_run(recorded)
         contact = spec.contact != "actuator"
     else:
         build, contact, duration = PROFILES[spec.profile]

@@ -11,13 +11,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import scipy.signal
 
 from landing_gear_sim.errors import ScenarioError
 from landing_gear_sim.model.parameters import RigParameters
+from msg_tools.run import Run
+from msg_tools.units import PA_PER_BAR
 
 Profile = Callable[[np.ndarray], np.ndarray]
 """Current reference [A] as a function of time since the profile started [s], shapes (n,)."""
@@ -122,6 +123,17 @@ def steps_then_sweep() -> Profile:
     return lambda t: np.where(t < t_sweep, stair(t), sweep(t - t_sweep))
 
 
+BRAKE_ON_CURRENT_A = 0.01
+"""A valve current above this is a brake command (the dead-band is ~0.1 A; 10 mA stays
+clear of logging noise and of the zero current before braking)."""
+
+
+def brake_start_index(current_a: np.ndarray) -> int | None:
+    """Index of the first sample whose current commands the brake, or None if none does."""
+    on = np.flatnonzero(np.asarray(current_a) > BRAKE_ON_CURRENT_A)
+    return int(on[0]) if on.size else None
+
+
 def logged_to_held(current_logged_a: np.ndarray) -> np.ndarray:
     """Model input from a logged current.
 
@@ -156,12 +168,10 @@ def from_samples(time_s: np.ndarray, current_a: np.ndarray, name: str = "file") 
     return profile
 
 
-def from_file(path: Path) -> tuple[Profile, float]:
-    """The recorded current of a run (CSV or bag); returns the profile and its duration."""
-    from msg_tools.io import read_run  # run I/O lives in msg_tools
-
-    run = read_run(Path(path))
-    profile = from_samples(run.time_s, logged_to_held(run.current_a), str(path))
+def from_run(run: Run) -> tuple[Profile, float]:
+    """The recorded current of a run as a profile (held as the valve saw it), and the run's
+    duration [s]."""
+    profile = from_samples(run.time_s, logged_to_held(run.current_a), run.source or run.name)
     return profile, float(run.time_s[-1] - run.time_s[0]) + 1.0 / run.rate_hz
 
 
@@ -172,15 +182,14 @@ def current_for_pressure(params: RigParameters, pressure_pa: float) -> float:
     k1, k2 = params.number("actuator.map_k1_pa_per_a"), params.number("actuator.map_k2_pa_per_a2")
     p_max = params.number("actuator.max_pressure_pa")
     if not 0.0 <= pressure_pa <= p_max:
-        raise ScenarioError(
-            f"pressure {pressure_pa / 1e5:g} bar is outside the valve range 0..{p_max / 1e5:g} bar"
-        )
+        raise ScenarioError(f"pressure {pressure_pa / PA_PER_BAR:g} bar is outside the valve "
+                            f"range 0..{p_max / PA_PER_BAR:g} bar")
     target = pressure_pa / params.number("actuator.gain")
     excess = target / k1 if k2 == 0 else (-k1 + math.sqrt(k1 * k1 + 4 * k2 * target)) / (2 * k2)
     current = params.number("actuator.deadband_current_a") + excess
     if current > params.number("actuator.max_current_a"):
-        raise ScenarioError(f"pressure {pressure_pa / 1e5:g} bar needs more than the valve's "
-                            f"{params.number('actuator.max_current_a'):g} A")
+        raise ScenarioError(f"pressure {pressure_pa / PA_PER_BAR:g} bar needs more than the "
+                            f"valve's {params.number('actuator.max_current_a'):g} A")
     return current
 
 
@@ -215,4 +224,5 @@ def constant_pressure_test(params: RigParameters, pressure_pa: float,
                            rate_hz: float | None = None) -> Scenario:
     """Rig test braking at the current that gives ``pressure_pa`` in steady state."""
     level = current_for_pressure(params, pressure_pa)
-    return rig_test(params, constant(level), f"brake_const_{pressure_pa / 1e5:g}bar", rate_hz)
+    name = f"brake_const_{pressure_pa / PA_PER_BAR:g}bar"
+    return rig_test(params, constant(level), name, rate_hz)

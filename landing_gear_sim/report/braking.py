@@ -1,4 +1,5 @@
-"""The braking-run figure of the paper's Fig. 1: slip, and wheel vs flywheel speed."""
+"""A braking run: the figure of the paper's Fig. 1 (slip, wheel vs flywheel speed, pressure)
+and the metrics table."""
 
 from __future__ import annotations
 
@@ -8,8 +9,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from antiskid.metrics import BrakingMetrics
-from landing_gear_sim.report.figures import save_figure  # also selects the Agg backend
+from landing_gear_sim.report.figures import save_figure
 from msg_tools.run import Run
+from msg_tools.units import PA_PER_BAR
 
 
 def plot_braking(run: Run, slip: np.ndarray, wheel_speed_m_s: np.ndarray,
@@ -25,10 +27,25 @@ def plot_braking(run: Run, slip: np.ndarray, wheel_speed_m_s: np.ndarray,
     axes[1].plot(run.time_s, wheel_speed_m_s, label="wheel", lw=0.8)
     axes[1].set_ylabel("speed [m/s]")
     axes[1].legend(loc="upper right")
-    axes[2].plot(run.time_s, run.pressure_pa / 1e5, lw=0.8)
+    axes[2].plot(run.time_s, run.pressure_pa / PA_PER_BAR, lw=0.8)
     axes[2].set_ylabel("brake pressure [bar]")
     axes[2].set_xlabel("time [s]")
     for axis in axes:
         axis.grid(alpha=0.3)
     figure.tight_layout()
     return save_figure(figure, path)
+
+
+def metrics_table(rows: dict[str, BrakingMetrics]) -> str:
+    """One line per run: efficiency, friction, stop, slip, locks, cycling."""
+    header = (f"{'run':24s} {'eff':>5s} {'mu':>5s} {'stop m':>7s} {'stop s':>6s} "
+              f"{'decel':>6s} {'slip rms':>8s} {'max':>5s} {'locks':>5s} {'cycling Hz':>10s}")
+    lines = [header]
+    for name, m in rows.items():
+        lines.append(f"{name:24s} {m.braking_efficiency:5.3f} {m.mean_friction:5.3f} "
+                     f"{m.stopping_distance_m:7.1f} {m.stopping_time_s:6.2f} "
+                     f"{m.mean_deceleration_m_s2:6.2f} {m.slip_rms:8.3f} {m.slip_max:5.3f} "
+                     f"{m.lock_events:5d} {m.cycling_frequency_hz:10.2f}")
+    return "\n".join(lines)
+
+

@@ -1,6 +1,5 @@
-"""Figures. Functions take computed results and draw them; they never simulate.
-
-matplotlib runs on the non-interactive Agg backend: figures go to PNG files.
+"""Figures of the model: a simulated run, the frequency responses; and what every figure
+shares (saving, display units). Functions take computed results; they never simulate.
 """
 
 from __future__ import annotations
@@ -8,14 +7,18 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
 from landing_gear_sim.model.integrate import SimulationResult
 from landing_gear_sim.model.linear import FrequencyResponse
+from msg_tools.units import PA_PER_BAR
+
+DISPLAY_UNITS: dict[str, tuple[float, str]] = {
+    "pressure_pa": (1 / PA_PER_BAR, "bar"), "wheel_speed_rad_s": (1.0, "rad/s"),
+    "flywheel_speed_rad_s": (1.0, "rad/s"), "vertical_load_n": (1e-3, "kN"),
+    "longitudinal_force_n": (1e-3, "kN")}
+"""Run channel (SI) → (factor, unit) it is shown in."""
 
 
 def save_figure(fig: plt.Figure, path: Path) -> Path:
@@ -38,7 +41,7 @@ def plot_simulation(result: SimulationResult, path: Path) -> Path:
     axes[1].plot(t, result.slip, "b")
     axes[1].set_ylabel(r"slip $\lambda$ [-]")
     axes[1].set_ylim(-0.05, 1.05)
-    axes[2].plot(t, result.pressure_pa / 1e5, "m", label="brake pressure")
+    axes[2].plot(t, result.pressure_pa / PA_PER_BAR, "m", label="brake pressure")
     axes[2].set_ylabel("pressure [bar]")
     current_axis = axes[2].twinx()
     current_axis.plot(t, result.current_a, color="grey", lw=0.8, label="valve current")

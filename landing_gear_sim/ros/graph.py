@@ -12,8 +12,10 @@ from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from landing_gear_sim.errors import LandingGearSimError
-from landing_gear_sim.model.runspec import RunSpec
+from landing_gear_sim.errors import GraphError
+from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.runspec import RunSpec, build_scenario
+from landing_gear_sim.model.scenario import Scenario
 from msg_tools.contract import (
     TOPIC_CURRENT,
     TOPIC_FLYWHEEL,
@@ -21,6 +23,8 @@ from msg_tools.contract import (
     TOPIC_WHEEL,
     TOPIC_WRENCH,
 )
+from msg_tools.io import read_run
+from msg_tools.units import PA_PER_BAR
 
 PACKAGE = "landing_gear_sim"
 
@@ -92,13 +96,13 @@ class GraphOptions:
 
     def __post_init__(self) -> None:
         if self.clock not in CLOCKS:
-            raise LandingGearSimError(f"clock must be one of {', '.join(CLOCKS)}")
+            raise GraphError(f"clock must be one of {', '.join(CLOCKS)}")
         if self.storage not in STORAGES:
-            raise LandingGearSimError(f"storage must be one of {', '.join(STORAGES)}")
+            raise GraphError(f"storage must be one of {', '.join(STORAGES)}")
         if not (math.isfinite(self.timeout_s) and self.timeout_s > 0):
-            raise LandingGearSimError("the lockstep timeout must be > 0 s")
+            raise GraphError("the lockstep timeout must be > 0 s")
         if self.replay and self.run.profile != "file":
-            raise LandingGearSimError("a replay graph needs the run file (profile 'file')")
+            raise GraphError("a replay graph needs the run file (profile 'file')")
 
 
 LAUNCH_ARGUMENTS: dict[str, tuple[str, str]] = {
@@ -112,6 +116,17 @@ LAUNCH_ARGUMENTS: dict[str, tuple[str, str]] = {
     "controller": ("", "anti-skid controller type instead of the profile (threshold | slip)"),
 }
 """Launch-file arguments: name -> (default, description)."""
+
+
+def load_scenario(spec: RunSpec, params: RigParameters) -> Scenario:
+    """The scenario of ``spec``, reading its recorded run when the profile is ``file``
+    (what every node of the graph and ``simulate`` run).
+
+    Raises:
+        ScenarioError, RunFormatError: the profile cannot be built or the run not read.
+    """
+    recorded = read_run(Path(spec.file)) if spec.replays_file else None
+    return build_scenario(spec, params, recorded)
 
 
 def controlled_run(run: RunSpec, controller: str | None) -> RunSpec:
@@ -128,9 +143,9 @@ def options_from_arguments(values: dict[str, str]) -> tuple[GraphOptions, Path]:
         return values.get(name, LAUNCH_ARGUMENTS[name][0])
 
     try:
-        pressure_pa = float(value("pressure_bar")) * 1e5
+        pressure_pa = float(value("pressure_bar")) * PA_PER_BAR
     except ValueError:
-        raise LandingGearSimError(
+        raise GraphError(
             f"pressure_bar must be a number, got {value('pressure_bar')!r}") from None
     controller = value("controller") or None
     run = controlled_run(RunSpec(profile=value("profile"), file=value("file"),

@@ -17,7 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.errors import GraphError
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.ros.graph import GraphOptions, NodeSpec, ParamValue, describe
 
@@ -115,7 +115,7 @@ def _wait_for_plant(processes: dict[str, subprocess.Popen], say: Callable[[str],
                 continue
             reported.add(name)
             if code == 2:  # a configuration error: the run cannot start
-                raise LandingGearSimError(f"node {name} refused its configuration (see above)")
+                raise GraphError(f"node {name} refused its configuration (see above)")
             if code != 0:
                 say(f"node {name} died (exit code {code}); the plant holds its input")
         time.sleep(0.05)

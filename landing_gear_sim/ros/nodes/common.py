@@ -27,11 +27,11 @@ from rclpy.subscription import Subscription
 from sensor_msgs.msg import FluidPressure, JointState
 from std_msgs.msg import Float64, String, UInt64
 
-from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.errors import GraphError, LandingGearSimError
 from landing_gear_sim.model.parameters import SPECS, RigParameters, load_parameters
-from landing_gear_sim.model.runspec import RunSpec, build_scenario
+from landing_gear_sim.model.runspec import RunSpec
 from landing_gear_sim.model.scenario import Scenario
-from landing_gear_sim.ros.graph import TOPIC_READY, TOPIC_RUN_END
+from landing_gear_sim.ros.graph import TOPIC_READY, TOPIC_RUN_END, load_scenario
 from msg_tools.contract import (
     TOPIC_CURRENT,
     TOPIC_FLYWHEEL,
@@ -39,7 +39,6 @@ from msg_tools.contract import (
     TOPIC_WHEEL,
     TOPIC_WRENCH,
 )
-from msg_tools.errors import RunFormatError
 
 DATA_QOS = QoSProfile(reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST,
                       depth=5000, durability=DurabilityPolicy.VOLATILE)
@@ -80,7 +79,8 @@ def run_spec(node: Node) -> RunSpec:
                             "from run.pressure_pa"))
     return RunSpec(
         profile=str(declare(node, "run.profile", "constant", "current profile")),
-        pressure_pa=float(declare(node, "run.pressure_pa", 30e5, "constant profile pressure [Pa]")),
+        pressure_pa=float(declare(node, "run.pressure_pa", RunSpec.pressure_pa,
+                                    "constant profile pressure [Pa]")),
         current_a=current if current >= 0 else math.nan,
         file=str(declare(node, "run.file", "", "file profile: run (CSV or bag)")),
         contact=str(declare(node, "run.contact", "auto", "auto | rig | actuator")),
@@ -95,14 +95,14 @@ def rig_and_run(node: Node) -> tuple[RigParameters, Scenario, bool]:
     whether the graph runs in lockstep.
     """
     params = rig_parameters(node)
-    return params, build_scenario(run_spec(node), params), lockstep(node)
+    return params, load_scenario(run_spec(node), params), lockstep(node)
 
 
 def lockstep(node: Node) -> bool:
     """Declare ``clock`` and say whether this graph runs in lockstep."""
     clock = str(declare(node, "clock", "lockstep", "lockstep | realtime"))
     if clock not in ("lockstep", "realtime"):
-        raise LandingGearSimError(f"clock must be lockstep or realtime, got {clock!r}")
+        raise GraphError(f"clock must be lockstep or realtime, got {clock!r}")
     return clock == "lockstep"
 
 
@@ -162,7 +162,7 @@ def _parse_counts(items: Iterable[str]) -> dict[str, int]:
             continue
         topic, _, count = str(item).partition("=")
         if not count.isdigit():
-            raise LandingGearSimError(f"expected_subscribers: {item!r} is not topic=count")
+            raise GraphError(f"expected_subscribers: {item!r} is not topic=count")
         counts[topic] = int(count)
     return counts
 
@@ -287,7 +287,7 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None) -> int:
         spin(node)
     except (RunFinishedError, KeyboardInterrupt, ExternalShutdownException):
         pass
-    except (LandingGearSimError, RunFormatError) as exc:
+    except LandingGearSimError as exc:
         print(f"{_program()}: error: {exc}", file=sys.stderr)
         return 2
     finally:

@@ -45,6 +45,7 @@ from msg_tools.contract import (
     TOPIC_WHEEL,
     TOPIC_WRENCH,
 )
+from msg_tools.units import PA_PER_BAR
 
 ACTUATOR, LOADING = "actuator", "loading_device"
 LOST_CHUNK = 500  # steps per watchdog tick once every input is lost: keep the executor responsive
@@ -209,7 +210,7 @@ class PlantNode(GraphNode):
         for peer in self._pending:
             if peer not in self._lost and target not in self._pending[peer]:
                 self._lost.add(peer)
-                held = (f"brake pressure set to the safe {self._safe_pa / 1e5:g} bar"
+                held = (f"brake pressure set to the safe {self._safe_pa / PA_PER_BAR:g} bar"
                         if peer == ACTUATOR
                         else f"vertical force held at {self._plant.load_n:.0f} N")
                 self.get_logger().error(f"no input from {peer} for {self._timeout_s:g} s at "

@@ -20,7 +20,7 @@ import struct
 import time
 from pathlib import Path
 
-from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.errors import GraphError
 from landing_gear_sim.ros.graph import SENSOR_TOPICS
 from landing_gear_sim.ros.nodes.common import (
     CONTRACT_KINDS,
@@ -58,7 +58,7 @@ class RecorderNode(GraphNode):
                                             "fewest samples per closed segment"))
         self._in_segment = 0
         if not path:
-            raise LandingGearSimError("recorder needs the parameter bag:=FOLDER")
+            raise GraphError("recorder needs the parameter bag:=FOLDER")
         self._writer = SegmentedBagWriter(Path(path), TOPIC_TYPES, storage)
         self._samples: dict[int, dict[str, bytes]] = {}
         self._order: list[int] = []  # sample stamps in order (the wheel topic's arrival order)

@@ -16,7 +16,7 @@ from pathlib import Path
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import UInt64
 
-from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.errors import GraphError
 from landing_gear_sim.model.runspec import build_scenario
 from landing_gear_sim.ros.graph import TOPIC_CLOCK, TOPIC_RUN_END
 from landing_gear_sim.ros.nodes.common import (
@@ -53,16 +53,16 @@ class ReplayNode(GraphNode):
         readers = int(declare(self, "wait_for_subscribers", 0,
                               "topics=all: start once every topic has this many readers"))
         if mode not in MODES:
-            raise LandingGearSimError(f"topics must be one of {', '.join(MODES)}, got {mode!r}")
+            raise GraphError(f"topics must be one of {', '.join(MODES)}, got {mode!r}")
         if not path:
-            raise LandingGearSimError("replay needs the parameter file:=RUN (CSV or bag)")
+            raise GraphError("replay needs the parameter file:=RUN (CSV or bag)")
         if not self._speed > 0:
-            raise LandingGearSimError(f"speed must be > 0, got {self._speed}")
+            raise GraphError(f"speed must be > 0, got {self._speed}")
         self._run = read_run(Path(path), read_mapping(Path(mapping)) if mapping else None)
         if mode == "current":
             params = rig_parameters(self)
             spec = replace(run_spec(self), profile="file", file=path)
-            scenario = build_scenario(spec, params)
+            scenario = build_scenario(spec, params, self._run)
             self._feed = CurrentFeed(self, scenario.current_a, scenario.rate_hz, ahead)
             return
         self._out = {topic: self.publisher(kind, topic, DATA_QOS)

@@ -1,0 +1,118 @@
+"""Actuator identification (paper Section IV-C): the valve's static map from a quasi-static
+ramp; A(s) from steps and a sweep — H1 frequency response with coherence (Welch), a
+second-order fit to it, refined by an output-error fit in the time domain."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.signal
+from scipy.optimize import least_squares
+
+from landing_gear_sim.calibration.statistics import Estimate, covariance_std
+from landing_gear_sim.model import elements as el
+from landing_gear_sim.model.actuator import actuator_pressure, second_order_response
+from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.scenario import logged_to_held
+from landing_gear_sim.model.sensors import SensorModel
+from msg_tools.run import Run
+from msg_tools.units import PA_PER_BAR
+
+STATIC_MAP = ("actuator.deadband_current_a", "actuator.map_k1_pa_per_a",
+              "actuator.map_k2_pa_per_a2", "actuator.max_pressure_pa")
+FRF_BAND_HZ = (0.5, 100.0)  # the sweep's band
+MIN_COHERENCE = 0.8  # FRF bins fitted: the measured pressure follows the valve there
+
+
+@dataclass(frozen=True)
+class FrfEstimate:
+    """Empirical actuator frequency response (static-map pressure → measured pressure) and
+    the model's A(s) beside it; arrays of shape (n,) over ``frequency_hz``."""
+
+    run: str
+    frequency_hz: np.ndarray
+    response: np.ndarray  # complex H1
+    coherence: np.ndarray
+    model: np.ndarray  # complex A(j 2π f) of the parameter set compared
+
+
+def fit_static_map(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
+    """Dead-band, k1, k2, saturation from quasi-static ramps (paper Fig. 8)."""
+    current = np.concatenate([r.current_a for r in runs])
+    pressure = SensorModel.of(p).true_pressure(np.concatenate([r.pressure_pa for r in runs]))
+    max_current = p.number("actuator.max_current_a")
+    scale = np.array([p.number(k) or 1.0 for k in STATIC_MAP])
+    scale[0] = max(scale[0], 0.05)
+
+    def residual(theta: np.ndarray) -> np.ndarray:
+        return (el.valve_map(current, max_current, *(theta * scale)) - pressure) / PA_PER_BAR
+
+    start = np.array([p.number(k) for k in STATIC_MAP]) / scale
+    fit = least_squares(residual, start, x_scale="jac")
+    std = covariance_std(fit, 4) * scale
+    names = tuple(r.name for r in runs)
+    return [Estimate(k, float(v), float(s), names, "static-map least squares")
+            for k, v, s in zip(STATIC_MAP, fit.x * scale, std, strict=True)]
+
+
+def actuator_frf(run: Run, params: RigParameters) -> FrfEstimate:
+    """H1 = P_yu/P_uu and coherence, u = static-map pressure of ``params``, y = measured
+    pressure; with the A(s) of ``params`` at the same frequencies."""
+    vector = params.vector()
+    u = np.array([el.valve_static_pressure(vector, i) for i in run.current_a])
+    y = run.pressure_pa
+    fs = run.rate_hz
+    nperseg = min(4096, u.size // 4)
+    f, puu = scipy.signal.welch(u - u.mean(), fs, nperseg=nperseg)
+    _, pyu = scipy.signal.csd(u - u.mean(), y - y.mean(), fs, nperseg=nperseg)
+    _, coherence = scipy.signal.coherence(u, y, fs, nperseg=nperseg)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        h1 = pyu / puu  # scipy's csd(u, y) is already the cross-spectrum of H1
+    model = second_order_response(f, params.number("actuator.natural_frequency_hz"),
+                                  params.number("actuator.damping_ratio"), 1.0)
+    return FrfEstimate(run.name, f, h1, coherence, model)
+
+
+def fit_actuator_dynamics(runs: Sequence[Run], p: RigParameters
+                          ) -> tuple[list[Estimate], FrfEstimate]:
+    """ω_n and ξ of A(s): FRF fit for a start, then output error on the measured pressure."""
+    run = max(runs, key=len)
+    frf = actuator_frf(run, p)
+    f, h1 = frf.frequency_hz, frf.response
+    band = ((f >= FRF_BAND_HZ[0]) & (f <= FRF_BAND_HZ[1]) & (frf.coherence > MIN_COHERENCE)
+            & np.isfinite(h1))
+    f0 = p.number("actuator.natural_frequency_hz")
+    zeta0 = p.number("actuator.damping_ratio")
+    weight = np.sqrt(frf.coherence[band])
+
+    def frf_residual(theta: np.ndarray) -> np.ndarray:
+        diff = (second_order_response(f[band], theta[0] * f0, theta[1], 1.0) - h1[band]) * weight
+        return np.concatenate([diff.real, diff.imag])
+
+    frf_fit = least_squares(frf_residual, [1.0, zeta0], bounds=([0.1, 0.05], [10.0, 3.0]))
+    f_frf, zeta_frf = frf_fit.x[0] * f0, frf_fit.x[1]
+    measured = SensorModel.of(p).true_pressure(run.pressure_pa)
+    held = logged_to_held(run.current_a)
+
+    def time_residual(theta: np.ndarray) -> np.ndarray:
+        trial = p.replace({"actuator.natural_frequency_hz": theta[0] / (2 * math.pi),
+                           "actuator.damping_ratio": theta[1]})
+        return (actuator_pressure(trial, held, run.rate_hz) - measured) / PA_PER_BAR
+
+    wn_frf = 2 * math.pi * f_frf
+    fit = least_squares(time_residual, [wn_frf, zeta_frf], x_scale=[wn_frf, 0.1],
+                        bounds=([1.0, 0.05], [2000.0, 3.0]))
+    std = covariance_std(fit, 2)
+    names = (run.name,)
+    estimates = [
+        Estimate("actuator.natural_frequency_hz", fit.x[0] / (2 * math.pi),
+                 std[0] / (2 * math.pi), names,
+                 f"output error on pressure (FRF fit gave {f_frf:.2f} Hz)"),
+        Estimate("actuator.damping_ratio", fit.x[1], std[1], names,
+                 f"output error on pressure (FRF fit gave {zeta_frf:.3f})"),
+    ]
+    fitted = p.replace({e.key: e.value for e in estimates}, "identify")
+    return estimates, actuator_frf(run, fitted)

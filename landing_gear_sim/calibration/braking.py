@@ -1,0 +1,185 @@
+"""Braking runs (paper Section IV-D): the rolling radius from free rolling, the flywheel's
+inertia and drag from its momentum balance, the brake gain (and fade) from the wheel's
+torque balance r F_x − J_w ω̇ = k_b P. Signals are low-passed (zero phase) first."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+import scipy.signal
+from scipy.optimize import least_squares
+
+from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.calibration.statistics import Estimate, covariance_std, linear_std
+from landing_gear_sim.errors import IdentificationError
+from landing_gear_sim.model.elements import fade_factor
+from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.quantities import rim_speed_m_s, rolling_radius_at
+from landing_gear_sim.model.sensors import SensorModel
+from msg_tools.units import PA_PER_BAR
+
+FILTER_HZ = 20.0  # zero-phase low-pass before differentiating speeds
+LOADED_N = 5e3  # the wheel is on the flywheel
+GAIN_UNIT = 1e-3  # the fade fit works with k_b in N m/kPa (order 1), torques in 100 N m
+TORQUE_UNIT_N_M = 100.0
+
+
+@dataclass(frozen=True)
+class Braking:
+    """Filtered signals of one braking run, SI, on the run's clock from its first sample."""
+
+    run: ClassifiedRun
+    time_s: np.ndarray
+    speed_m_s: np.ndarray
+    wheel: np.ndarray
+    wheel_rate: np.ndarray
+    pressure: np.ndarray
+    load: np.ndarray
+    force: np.ndarray
+    start_s: float
+
+    @property
+    def uniform_time_s(self) -> np.ndarray:
+        """The nominal sample instants k/rate (for filters that need an even grid)."""
+        return np.arange(self.time_s.size) / self.run.rate_hz
+
+
+def lowpass(values: np.ndarray, rate_hz: float, cutoff_hz: float = FILTER_HZ) -> np.ndarray:
+    sos = scipy.signal.butter(4, cutoff_hz / (rate_hz / 2), output="sos")
+    return scipy.signal.sosfiltfilt(sos, values)
+
+
+def prepare(run: ClassifiedRun, p: RigParameters) -> Braking:
+    """The filtered signals of a braking run under the parameter set ``p``."""
+    rate = run.rate_hz
+    wheel = lowpass(run.wheel_speed_rad_s, rate)
+    return Braking(
+        run=run, time_s=run.time_s - run.time_s[0],
+        speed_m_s=rim_speed_m_s(p, lowpass(run.flywheel_speed_rad_s, rate)),
+        wheel=wheel, wheel_rate=np.gradient(wheel, 1.0 / rate),
+        pressure=lowpass(SensorModel.of(p).true_pressure(run.pressure_pa), rate),
+        load=lowpass(run.vertical_load_n, rate),
+        force=lowpass(run.longitudinal_force_n, rate),
+        start_s=run.brake_start_s - float(run.time_s[0]),
+    )
+
+
+def free_rolling(b: Braking) -> np.ndarray:
+    """Samples after touch-down settled and before the brake acts."""
+    return (b.time_s > b.start_s - 1.0) & (b.time_s < b.start_s - 0.05) & (b.load > LOADED_N)
+
+
+def hub_speed(b: Braking, p: RigParameters) -> np.ndarray:
+    """v_h = v_f − L θ̇, θ from the measured F_x through the gear's spring-damper (eq. 6)."""
+    if not p.has("gear_walk"):
+        return b.speed_m_s
+    length = p.number("gear_walk.length_m")
+    system = scipy.signal.lti([length, 0.0], [p.number("gear_walk.inertia_kg_m2"),
+                                              p.number("gear_walk.damping_n_m_s_per_rad"),
+                                              p.number("gear_walk.stiffness_n_m_per_rad")])
+    _, rate, _ = scipy.signal.lsim(system, b.force, b.uniform_time_s)
+    return b.speed_m_s - length * rate
+
+
+def fit_unloaded_radius(runs: Sequence[Braking], p: RigParameters) -> Estimate:
+    """r0 from free rolling (λ = 0): r = v/ω at the load of that phase."""
+    values = []
+    for b in runs:
+        m = free_rolling(b)
+        if m.sum() > 50:
+            r_eff = np.mean(b.speed_m_s[m]) / np.mean(b.wheel[m])
+            values.append(r_eff + (p.number("wheel.unloaded_radius_m")
+                                   - float(np.mean(rolling_radius_at(p, b.load[m])))))
+    if not values:
+        raise IdentificationError("no free-rolling phase before braking")
+    std = float(np.std(values) / math.sqrt(len(values))) if len(values) > 1 else float("nan")
+    return Estimate("wheel.unloaded_radius_m", float(np.mean(values)), std,
+                    tuple(b.run.name for b in runs), "free rolling v/ω, a and b kept")
+
+
+def fit_flywheel(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
+    """J_f and α_d from the integrated balance M Δv = −∫F_x − α ∫v² (robust to noise).
+
+    Each run gets its own intercept: anchoring a run to one noisy speed sample
+    would shift all its rows and bias the drag.
+    """
+    blocks, targets = [], []
+    for b in runs:
+        idx = np.flatnonzero((b.time_s > 0.6) & (b.speed_m_s > 5.0))[::10]
+        if idx.size < 20:
+            continue
+        dt = np.diff(b.time_s, prepend=b.time_s[0])
+        blocks.append(np.column_stack([-np.cumsum(b.force * dt)[idx],
+                                       -np.cumsum(b.speed_m_s ** 2 * dt)[idx]]))
+        targets.append(b.speed_m_s[idx])
+    if not blocks:
+        raise IdentificationError("no braking run long enough for the flywheel balance")
+    offsets = scipy.linalg.block_diag(*[np.ones((len(y), 1)) for y in targets])
+    x = np.hstack([np.vstack(blocks), offsets])
+    y = np.concatenate(targets)
+    coef, *_ = np.linalg.lstsq(x, y, rcond=None)
+    std_inv, std_ratio = linear_std(x, y - x @ coef, x.shape[1])[:2]
+    inv_mass, alpha_over_mass = coef[:2]
+    mass = 1.0 / inv_mass
+    radius = p.number("flywheel.radius_m")
+    names = tuple(b.run.name for b in runs)
+    alpha = alpha_over_mass * mass
+    std_alpha = abs(alpha) * math.hypot(std_ratio / alpha_over_mass, std_inv * mass)
+    return [
+        Estimate("flywheel.inertia_kg_m2", mass * radius ** 2,
+                 mass ** 2 * std_inv * radius ** 2, names, "integrated momentum balance"),
+        Estimate("drag.coeff_n_s2_per_m2", float(alpha), float(std_alpha), names,
+                 "integrated momentum balance"),
+    ]
+
+
+def _torque_balance(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
+    """Brake torque r F_x − J_w ω̇ [N m] and the energy the brake absorbed, ∫ T_b ω dt [J]."""
+    torque = rolling_radius_at(p, b.load) * b.force - p.number("wheel.inertia_kg_m2") * b.wheel_rate
+    dt = np.diff(b.time_s, prepend=b.time_s[0])
+    power = np.where(b.time_s > b.start_s - 0.1, np.clip(torque, 0, None), 0.0) \
+        * np.clip(b.wheel, 0, None)
+    return torque, np.cumsum(power * dt)
+
+
+def fit_brake_gain(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
+    """k_b from the wheel torque balance r F_x − J_w ω̇ = k_b P (least squares).
+
+    When the model has brake fade, k_b, φ and E_f of k_b (1 − φ(1 − e^{−E/E_f})) P are
+    fitted together, E the energy absorbed so far (measured by the same balance).
+    """
+    torque, pressure, energy = [], [], []
+    for b in runs:
+        whole, absorbed = _torque_balance(b, p)
+        m = ((b.time_s > b.start_s + 0.2) & (b.pressure > 3 * PA_PER_BAR) & (b.wheel > 5.0)
+             & (b.load > LOADED_N))
+        torque.append(whole[m])
+        pressure.append(b.pressure[m])
+        energy.append(absorbed[m])
+    t, pr, e = np.concatenate(torque), np.concatenate(pressure), np.concatenate(energy)
+    names = tuple(b.run.name for b in runs)
+    if not p.has("brake_fade"):
+        gain = float(pr @ t / (pr @ pr))
+        std = float(linear_std(pr[:, None], t - gain * pr, 1)[0])
+        return [Estimate("brake.gain_n_m_per_pa", gain, std, names, "wheel torque balance")]
+    keys = ("brake.gain_n_m_per_pa", "brake.fade_fraction", "brake.fade_energy_j")
+
+    def residual(theta: np.ndarray) -> np.ndarray:
+        gain, fraction, log_energy = theta
+        fade = fade_factor(fraction, e, math.exp(log_energy))
+        return (gain * GAIN_UNIT * fade * pr - t) / TORQUE_UNIT_N_M
+
+    start = [p.number(keys[0]) / GAIN_UNIT, p.number(keys[1]), math.log(p.number(keys[2]))]
+    fit = least_squares(residual, start, bounds=([1e-3, 0.0, math.log(1e3)],
+                                                 [1e2, 0.95, math.log(1e9)]))
+    std = covariance_std(fit, 3)
+    gain, fraction, log_energy = fit.x
+    method = "wheel torque balance with fade"
+    return [Estimate(keys[0], gain * GAIN_UNIT, std[0] * GAIN_UNIT, names, method),
+            Estimate(keys[1], fraction, std[1], names, method),
+            Estimate(keys[2], math.exp(log_energy), math.exp(log_energy) * std[2], names,
+                     method)]

@@ -1,0 +1,107 @@
+"""The Burckhardt friction curve from braking runs: a direct fit of μ = F_x/F_z against the
+slip (eqs. 1, 4, 11), refined by an output-error fit of the wheel speed with a
+leave-one-run-out jackknife for an honest σ."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from landing_gear_sim.calibration.braking import LOADED_N, Braking, hub_speed
+from landing_gear_sim.calibration.measured import simulate_run
+from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
+from landing_gear_sim.calibration.statistics import Estimate, covariance_std
+from landing_gear_sim.model.elements import burckhardt_mu, slip_ratio
+from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.quantities import rolling_radius_at
+
+KEYS = ("friction.theta1", "friction.theta2", "friction.theta3")
+REFINE_BOUNDS = (0.2, 5.0)  # output-error refinement stays within these factors of the start
+
+
+def friction_samples(runs: Sequence[Braking], p: RigParameters
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """(slip, μ) from eq. (1) and μ = F_x/F_z over the braking phases, decimated to 100 Hz."""
+    slips, mus = [], []
+    stop = p.number("rig_test.stop_speed_m_s")
+    for b in runs:
+        m = (b.time_s > b.start_s + 0.3) & (b.speed_m_s > stop + 2.0) & (b.load > LOADED_N) \
+            & (b.wheel > 1.0)
+        idx = np.flatnonzero(m)[::10]
+        radius = rolling_radius_at(p, b.load[idx])
+        slips.append(slip_ratio(hub_speed(b, p)[idx], b.wheel[idx], radius))
+        mus.append(b.force[idx] / b.load[idx])
+    return np.concatenate(slips), np.concatenate(mus)
+
+
+def fit_friction(slip: np.ndarray, mu: np.ndarray, p: RigParameters, names: tuple[str, ...],
+                 fix_theta3: bool = False) -> list[Estimate]:
+    """Burckhardt ϑ1, ϑ2, ϑ3 by nonlinear least squares (ϑ3 optionally fixed, paper [13])."""
+    keys = KEYS
+    start = np.array([p.number(k) for k in keys])
+    free = 2 if fix_theta3 else 3
+
+    def residual(theta: np.ndarray) -> np.ndarray:
+        t3 = start[2] if fix_theta3 else theta[2]
+        return burckhardt_mu(theta[0], theta[1], t3, slip) - mu
+
+    fit = least_squares(residual, start[:free], x_scale=start[:free],
+                        bounds=(np.zeros(free), np.full(free, np.inf)))
+    std = covariance_std(fit, free)
+    method = "Burckhardt least squares on slip/μ samples" + (" (theta3 fixed)" if fix_theta3
+                                                             else "")
+    estimates = [Estimate(k, float(v), float(s), names, method)
+                 for k, v, s in zip(keys[:free], fit.x, std, strict=True)]
+    if fix_theta3:
+        estimates.append(Estimate(keys[2], float(start[2]), 0.0, (), "fixed"))
+    return estimates
+
+
+def refine_friction(runs: Sequence[ClassifiedRun], p: RigParameters, jackknife: bool = True
+                    ) -> list[Estimate]:
+    """Output-error refinement of ϑ1..ϑ3: simulate the braking runs with their measured
+    current and fit the wheel speed over the braking phase.
+
+    Open-loop braking rarely leaves the low-slip region, so the direct fit trades ϑ3
+    against ϑ1, ϑ2; the wheel-speed response to the slip excursions pins them down.
+    """
+    keys = KEYS
+    start = np.array([p.number(k) for k in keys])
+    windows = [braking_window(r, p) for r in runs]
+
+    def slip_error(run: ClassifiedRun, window: np.ndarray, trial: RigParameters) -> np.ndarray:
+        # wheel-speed error less what the flywheel-speed error explains: a common speed
+        # offset (noisy initial speed, drag) is not the friction curve's doing
+        simulated = simulate_run(run, trial)[0]
+        ratio = trial.number("flywheel.radius_m") / trial.number("wheel.unloaded_radius_m")
+        wheel = simulated.wheel_speed_rad_s[window] - run.wheel_speed_rad_s[window]
+        flywheel = simulated.flywheel_speed_rad_s[window] - run.flywheel_speed_rad_s[window]
+        return (wheel - ratio * flywheel)[::5]
+
+    def residual(theta: np.ndarray, chosen: Sequence[int]) -> np.ndarray:
+        trial = p.replace(dict(zip(keys, theta * start, strict=True)), "identify")
+        return np.concatenate([slip_error(runs[i], windows[i], trial) for i in chosen])
+
+    fit = least_squares(lambda th: residual(th, range(len(runs))), np.ones(3), diff_step=1e-4,
+                        bounds=REFINE_BOUNDS)
+    std = covariance_std(fit, 3)
+    if jackknife:
+        std = np.maximum(std, _jackknife_std(residual, fit.x, len(runs)))
+    names = tuple(r.name for r in runs)
+    return [Estimate(k, float(v), float(sd), names,
+                     "output error on wheel vs flywheel speed; σ: max(residual, jackknife)")
+            for k, v, sd in zip(keys, fit.x * start, std * start, strict=True)]
+
+
+def _jackknife_std(residual: Callable[[np.ndarray, Sequence[int]], np.ndarray],
+                   solution: np.ndarray, n_runs: int) -> np.ndarray:
+    """Leave-one-run-out spread of the fit: run-to-run variability the residuals hide."""
+    if n_runs < 3:
+        return np.zeros_like(solution)
+    fits = [least_squares(lambda th, i=i: residual(th, [j for j in range(n_runs) if j != i]),
+                          solution, diff_step=1e-4, bounds=REFINE_BOUNDS).x
+            for i in range(n_runs)]
+    spread = np.asarray(fits) - np.mean(fits, axis=0)
+    return np.sqrt((n_runs - 1) / n_runs * np.sum(spread ** 2, axis=0))

@@ -1,0 +1,78 @@
+"""Measured runs through the model: each run simulated with its own measured input.
+
+This is the one place where a measurement becomes a simulation: identification's
+output-error fits, validation, the diagnosis and its report all call
+:func:`simulate_run`. The simulation is noise-free (the sensor offset of the model
+included): a comparison never carries random noise of the model's own.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from landing_gear_sim.calibration.runs import ClassifiedRun, classified
+from landing_gear_sim.model.integrate import SimulationResult, simulate
+from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.quantities import rim_speed_m_s
+from landing_gear_sim.model.scenario import Scenario, logged_to_held
+from msg_tools.io import is_uniform, resample
+from msg_tools.run import Run
+
+CHANNELS: dict[str, str] = {
+    "pressure_pa": "brake pressure [Pa]",
+    "wheel_speed_rad_s": "wheel speed [rad/s]",
+    "flywheel_speed_rad_s": "flywheel speed [rad/s]",
+    "vertical_load_n": "vertical load [N]",
+    "longitudinal_force_n": "longitudinal force [N]",
+}
+"""Measured channels a simulation is compared on (Run fields), with their label."""
+ACTUATOR_CHANNELS = ("pressure_pa",)
+"""An actuator-only run carries information on the pressure alone."""
+LOWEST_SIM_SPEED_M_S = 1.0  # below this slip is ill-defined; the rig stops at 3 m/s
+INITIAL_SPEED_SAMPLES = 20  # the initial speed is the mean of this many samples
+
+
+def channels_of(run: ClassifiedRun) -> tuple[str, ...]:
+    """The channels that carry information in ``run``."""
+    return tuple(CHANNELS) if run.braking else ACTUATOR_CHANNELS
+
+
+def scenario_for_run(run: ClassifiedRun, params: RigParameters,
+                     timing: Run | None = None) -> Scenario:
+    """The measured run's input as a scenario: its current, its initial speed, its timing
+    (``timing``: the same run on another time base, e.g. resampled)."""
+    base = timing or run
+    initial = float(np.mean(rim_speed_m_s(params, base.flywheel_speed_rad_s[
+        :INITIAL_SPEED_SAMPLES])))
+    contact = run.braking
+    return Scenario(run.name, logged_to_held(base.current_a), base.rate_hz, contact,
+                    initial if contact else 0.0, LOWEST_SIM_SPEED_M_S if contact else 0.0,
+                    "measured input")
+
+
+def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult]:
+    """Simulate ``run`` with its measured current; the result on the run's time base.
+
+    If the model stops (speed below 1 m/s) before the measurement ends, the last
+    simulated sample is held, so both have the same length, except the pressure: the
+    valve goes on following the measured current. The touch-down time is the run's
+    start, as in the rig procedure.
+    """
+    run = classified(run)
+    uniform = run if is_uniform(run, 1e-3) else resample(run, round(run.rate_hz))
+    result = simulate(params, scenario_for_run(run, params, uniform))
+    simulated = result.to_run()
+    n, m = len(uniform), len(simulated)
+    take = np.minimum(np.arange(n), m - 1)
+    fields = {name: getattr(simulated, name)[take] for name in CHANNELS}
+    if m < n:
+        fields["pressure_pa"] = result.sensed_pressure_to_end()[:n]
+    return Run(name=run.name, source="simulation", time_s=uniform.time_s,
+               current_a=uniform.current_a, **fields), result
+
+
+def simulate_all(runs: Sequence[Run], params: RigParameters) -> list[Run]:
+    """Every run simulated with its measured input, on its own time base."""
+    return [simulate_run(run, params)[0] for run in runs]

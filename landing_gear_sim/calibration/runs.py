@@ -1,0 +1,131 @@
+"""Measured runs and their kinds: each run classified once, from its signals, and carried.
+
+A :class:`ClassifiedRun` is a :class:`~msg_tools.run.Run` that knows its
+:class:`RunKind` and its braking start; identification, validation and diagnosis
+classify the runs they are given once (:func:`classified`) and pass these on.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.quantities import rim_speed_m_s
+from landing_gear_sim.model.scenario import brake_start_index
+from msg_tools.run import Run
+
+STILL_FLYWHEEL_RAD_S = 1.0  # an actuator-only run: the flywheel stands still ...
+NO_CONTACT_LOAD_N = 2e3  # ... and the wheel carries (almost) no load
+RAMP_STEP_A = 2e-3  # largest current change per sample of a quasi-static ramp
+RAMP_SPAN_A = 0.5  # ... which must cover this much of the valve's range
+CONSTANT_STD_A = 5e-3  # a braking run whose current varies less than this is constant
+SETTLE_S = 0.3  # after the braking start the current has settled
+
+
+class Family(enum.Enum):
+    """Wheel off the flywheel (actuator-only test) or on it (braking test)."""
+
+    ACTUATOR = "actuator"
+    BRAKE = "brake"
+
+    def __str__(self) -> str:
+        return self.value
+
+
+class RunKind(str, enum.Enum):
+    """What a run is, read from its signals. Compares equal to its value (JSON, tables)."""
+
+    ACTUATOR_RAMP = "actuator_ramp"
+    ACTUATOR_DYNAMIC = "actuator_dynamic"
+    BRAKE_CONSTANT = "brake_constant"
+    BRAKE_OSCILLATING = "brake_oscillating"
+
+    def __str__(self) -> str:
+        return self.value
+
+    @property
+    def family(self) -> Family:
+        return Family.ACTUATOR if self.value.startswith("actuator") else Family.BRAKE
+
+    @property
+    def braking(self) -> bool:
+        """The wheel is on the flywheel: speeds, loads and forces carry information."""
+        return self.family is Family.BRAKE
+
+
+Selector = RunKind | Family
+"""A run kind, or a whole family of kinds."""
+
+
+def family_of(selector: Selector) -> Family:
+    return selector.family if isinstance(selector, RunKind) else selector
+
+
+def matches(kind: RunKind, selectors: Iterable[Selector]) -> bool:
+    """Whether ``kind`` is one of ``selectors`` (kinds or families)."""
+    return any(kind is s or kind.family is s for s in selectors)
+
+
+@dataclass(frozen=True)
+class ClassifiedRun(Run):
+    """A run with its kind and its braking start [s, on the run's own clock] (the first
+    brake command; the run's end when there is none)."""
+
+    kind: RunKind = dataclasses.field(kw_only=True)
+    brake_start_s: float = dataclasses.field(kw_only=True)
+
+    @classmethod
+    def of(cls, run: Run) -> ClassifiedRun:
+        fields = {f.name: getattr(run, f.name) for f in dataclasses.fields(Run)}
+        return cls(**fields, kind=classify(run), brake_start_s=brake_start_s(run))
+
+    @property
+    def braking(self) -> bool:
+        return self.kind.braking
+
+
+def classified(run: Run) -> ClassifiedRun:
+    """``run`` classified (a run classified already is returned as it is)."""
+    return run if isinstance(run, ClassifiedRun) else ClassifiedRun.of(run)
+
+
+def classify_all(runs: Iterable[Run]) -> list[ClassifiedRun]:
+    return [classified(r) for r in runs]
+
+
+def select(runs: Sequence[ClassifiedRun], selectors: Iterable[Selector]) -> list[ClassifiedRun]:
+    """The runs of one of ``selectors`` (kinds or families), in order."""
+    chosen = tuple(selectors)
+    return [r for r in runs if matches(r.kind, chosen)]
+
+
+def classify(run: Run) -> RunKind:
+    """The kind of ``run`` from its signals: actuator-only (flywheel still, no load) as a
+    quasi-static ramp or dynamic; braking at constant or oscillating current."""
+    if (np.max(run.flywheel_speed_rad_s) < STILL_FLYWHEEL_RAD_S
+            and np.max(np.abs(run.vertical_load_n)) < NO_CONTACT_LOAD_N):
+        slow = np.max(np.abs(np.diff(run.current_a))) < RAMP_STEP_A
+        ramp = slow and np.ptp(run.current_a) > RAMP_SPAN_A
+        return RunKind.ACTUATOR_RAMP if ramp else RunKind.ACTUATOR_DYNAMIC
+    settled = run.time_s > brake_start_s(run) + SETTLE_S
+    if settled.sum() < 10 or np.std(run.current_a[settled]) < CONSTANT_STD_A:
+        return RunKind.BRAKE_CONSTANT
+    return RunKind.BRAKE_OSCILLATING
+
+
+def brake_start_s(run: Run) -> float:
+    """Time of the first brake command (or the run's end if never) [s, run clock]."""
+    index = brake_start_index(run.current_a)
+    return float(run.time_s[-1] if index is None else run.time_s[index])
+
+
+def braking_window(run: ClassifiedRun, params: RigParameters) -> np.ndarray:
+    """Samples from the brake application to where the rig is about to stop (mask (n,))."""
+    speed = rim_speed_m_s(params, run.flywheel_speed_rad_s)
+    return (run.time_s >= run.brake_start_s) & (
+        speed > params.number("rig_test.stop_speed_m_s") + 1.0)

@@ -1,0 +1,69 @@
+"""``landing-gear-sim``: the command-line front end, thin over the layers below.
+
+Every user error ends as one line ``landing-gear-sim: error: ...`` and exit code 2.
+The commands live in :mod:`~landing_gear_sim.cli.model` (simulate, rig, bode, params,
+campaign, convert) and :mod:`~landing_gear_sim.cli.analysis` (identify, validate,
+compare, diagnose, metrics, antiskid); nothing in the package imports this one.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable, Sequence
+
+from landing_gear_sim import __version__
+from landing_gear_sim.cli import analysis, model
+from landing_gear_sim.cli.common import PROG
+from landing_gear_sim.errors import LandingGearSimError
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog=PROG, description="Landing-gear anti-skid rig "
+                                     "digital twin: simulate, analyse, compare.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+    model.register(sub)
+    analysis.register(sub)
+    return parser
+
+
+def _check(args: argparse.Namespace, parser: argparse.ArgumentParser) -> None:
+    if args.command == "simulate":
+        if args.rate is not None and args.rate <= 0:
+            parser.error("--rate must be > 0")
+        if args.duration is not None and args.duration <= 0:
+            parser.error("--duration must be > 0")
+    if args.command == "bode":
+        if not 0 < args.slip < 1:
+            parser.error("--slip must be in (0, 1)")
+        if not 0 < args.fmin < args.fmax:
+            parser.error("need 0 < --fmin < --fmax")
+        if any(v <= 0 for v in args.speeds):
+            parser.error("--speeds must be > 0")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    _check(args, parser)
+    try:
+        return int(args.func(args))
+    except LandingGearSimError as exc:
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return 130
+
+
+def _entry(command: str) -> Callable[[], int]:
+    def run() -> int:
+        return main([command, *sys.argv[1:]])
+
+    return run
+
+
+simulate_main = _entry("simulate")
+bode_main = _entry("bode")

@@ -1,0 +1,249 @@
+"""The analysis commands: identify, validate, compare, diagnose, metrics, antiskid."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from landing_gear_sim.cli.common import (
+    add_params_arguments,
+    mapping_of,
+    params_of,
+    progress,
+    write_atomically,
+)
+from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.model.parameters import RigParameters, parse_assignment
+from msg_tools.units import PA_PER_BAR
+
+if TYPE_CHECKING:
+    from antiskid.metrics import BrakingMetrics
+    from msg_tools.run import Run
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the sub-commands of this module to the ``landing-gear-sim`` parser."""
+    ident = sub.add_parser("identify", help="calibrate the model on a campaign folder")
+    ident.add_argument("campaign", type=Path, help="folder of runs (CSV files, bags)")
+    add_params_arguments(ident)
+    ident.add_argument("-o", "--output", type=Path, default=Path("out/calibrated.yaml"))
+    ident.add_argument("--fix-theta3", action="store_true", help="keep Burckhardt theta3")
+    ident.add_argument("--mapping", type=Path, help="column-mapping file for the CSVs")
+    ident.set_defaults(func=cmd_identify)
+
+    val = sub.add_parser("validate", help="simulate a campaign with its inputs; fit report")
+    val.add_argument("campaign", type=Path)
+    add_params_arguments(val)
+    val.add_argument("--report", type=Path, default=Path("out/validation"))
+    val.add_argument("--mapping", type=Path, help="column-mapping file for the CSVs")
+    val.set_defaults(func=cmd_validate)
+
+    cmp_ = sub.add_parser("compare", help="fit per channel of a simulated vs a measured run")
+    cmp_.add_argument("measured", type=Path)
+    cmp_.add_argument("simulated", type=Path)
+    cmp_.add_argument("--plot", type=Path, default=Path("out/compare.png"))
+    cmp_.add_argument("--mapping", type=Path, help="column-mapping file for MEASURED")
+    cmp_.set_defaults(func=cmd_compare)
+
+    diag = sub.add_parser("diagnose", help="why model and rig disagree: cause, extension, gain")
+    diag.add_argument("runs", type=Path, nargs="+", metavar="RUN",
+                      help="CSV files, bags, or campaign folders")
+    add_params_arguments(diag, without=False)
+    diag.add_argument("--without", action="extend", nargs="+", default=[], metavar="ELEMENT",
+                      dest="start_without",
+                      help="start from a model without these elements, e.g. gear_walk, "
+                      "friction_curve (the diagnosis must then rediscover them)")
+    diag.add_argument("--json", type=Path, help="write the diagnosis contract JSON here")
+    diag.add_argument("--report", type=Path, help="write the HTML report into this folder")
+    diag.add_argument("-o", "--output", type=Path, help="write the extended model (params)")
+    diag.add_argument("--mapping", type=Path, help="column-mapping file for the CSVs")
+    diag.set_defaults(func=cmd_diagnose)
+
+    met = sub.add_parser("metrics", help="braking metrics of a run (efficiency, locks, ...)")
+    met.add_argument("run", type=Path, help="CSV or bag of a braking run")
+    add_params_arguments(met)
+    met.add_argument("--mapping", type=Path, help="column-mapping file for a CSV")
+    met.add_argument("--plot", type=Path, help="PNG like the paper's Fig. 1")
+    met.add_argument("--json", type=Path, help="write the metrics as JSON")
+    met.set_defaults(func=cmd_metrics)
+
+    anti = sub.add_parser("antiskid", help="an anti-skid controller against the rig model, "
+                          "offline; metrics against a constant-pressure stop")
+    anti.add_argument("--controller", choices=["threshold", "slip"], default="threshold")
+    anti.add_argument("--surface", choices=["dry", "wet", "snow"], default="dry",
+                      help="runway friction curve (dry: the rig's own)")
+    add_params_arguments(anti)
+    anti.add_argument("--setting", action="append", default=[], metavar="KEY=VALUE",
+                      help="controller setting, e.g. --setting slip_setpoint=0.1")
+    anti.add_argument("--rate", type=float, help="controller rate [Hz] (default from config)")
+    anti.add_argument("-o", "--output", type=Path, help="CSV of the run (default out/)")
+    anti.add_argument("--plot", type=Path, help="PNG (default next to the CSV)")
+    anti.add_argument("--json", type=Path, help="write the metrics as JSON")
+    anti.set_defaults(func=cmd_antiskid)
+
+
+def cmd_identify(args: argparse.Namespace) -> int:
+    import json
+
+    from landing_gear_sim.calibration.identify import identify
+    from landing_gear_sim.report.pages import text_table
+    from landing_gear_sim.report.validation import estimates_table
+    from msg_tools.io import read_campaign
+
+    campaign = read_campaign(args.campaign, mapping_of(args))
+    for problem in campaign.problems:
+        progress(f"skipped: {problem}")
+    started = time.perf_counter()
+    result = identify(campaign.runs, params_of(args), args.fix_theta3, progress)
+    for name, kind in result.classes.items():
+        print(f"  {name:28s} {kind}")
+    for problem in result.problems:
+        print(f"  note: {problem}")
+    if not result.estimates:
+        raise LandingGearSimError(f"{args.campaign}: no identification step could run; "
+                                  f"nothing written")
+    print(text_table(["parameter", "value", "1-sigma", "method", "runs"],
+                     estimates_table(result.estimates)))
+    write_atomically(args.output, result.params.to_yaml)
+    evidence = result.to_json(str(args.campaign), campaign.problems)
+    sidecar = args.output.with_suffix(".identification.json")
+    write_atomically(sidecar, lambda p: p.write_text(json.dumps(evidence, indent=1)))
+    print(f"identified in {time.perf_counter() - started:.1f} s")
+    print(f"params:   {args.output}\nevidence: {sidecar}")
+    return 0
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    from landing_gear_sim.calibration.validate import validate_campaign
+    from landing_gear_sim.report.pages import text_table
+    from landing_gear_sim.report.validation import (
+        scores_header,
+        scores_table,
+        write_validation_report,
+    )
+    from msg_tools.io import read_campaign
+
+    campaign = read_campaign(args.campaign, mapping_of(args))
+    params = params_of(args)
+    progress(f"simulating {len(campaign.runs)} runs with their measured inputs")
+    validation = validate_campaign(campaign.runs, params)
+    print(text_table(scores_header(), scores_table(validation.comparisons)))
+    page = write_validation_report(validation, args.report, f"Validation of {args.campaign}")
+    print(f"report: {page}")
+    return 0
+
+
+def cmd_compare(args: argparse.Namespace) -> int:
+    from landing_gear_sim.calibration.validate import compare
+    from landing_gear_sim.report.pages import text_table
+    from landing_gear_sim.report.validation import plot_overlay
+    from msg_tools.io import read_run
+
+    measured, simulated = read_run(args.measured, mapping_of(args)), read_run(args.simulated)
+    comparison = compare(measured, simulated)
+    rows = [[channel, f"{s.fit_percent:.2f}", f"{s.rmse:.4g}", f"{s.max_error:.4g}"]
+            for channel, s in comparison.scores.items()]
+    print(text_table(["channel (SI)", "fit %", "RMSE", "max |error|"], rows))
+    print(f"plot: {plot_overlay(comparison, args.plot)}")
+    return 0
+
+
+def cmd_diagnose(args: argparse.Namespace) -> int:
+    import json
+
+    from landing_gear_sim.diagnosis.diagnose import diagnose
+    from landing_gear_sim.report.diagnosis import diagnosis_summary, write_diagnosis_report
+    from msg_tools.io import read_runs
+
+    campaign = read_runs(args.runs, mapping_of(args))
+    for problem in campaign.problems:
+        progress(f"skipped: {problem}")
+    started = time.perf_counter()
+    result = diagnose(campaign.runs, params_of(args), args.start_without,
+                      lambda m: progress(f"[{time.perf_counter() - started:5.1f} s] {m}"))
+    result.problems[:0] = campaign.problems
+    print(diagnosis_summary(result))
+    document = result.to_json()
+    if args.json:
+        write_atomically(args.json, lambda p: p.write_text(json.dumps(document, indent=1)))
+        print(f"json:   {args.json}")
+    if args.report:
+        progress("writing the report")
+        page = write_diagnosis_report(result, args.report)
+        print(f"report: {page}")
+    if args.output:
+        write_atomically(args.output, result.extended.to_yaml)
+        print(f"extended model: {args.output}")
+    print(f"diagnosed {len(campaign.runs)} runs in {time.perf_counter() - started:.1f} s")
+    return 0
+
+
+def cmd_metrics(args: argparse.Namespace) -> int:
+    from antiskid.metrics import braking_metrics
+    from landing_gear_sim.report.braking import metrics_table
+    from msg_tools.io import read_run
+
+    rig = params_of(args)
+    run = read_run(args.run, mapping_of(args))
+    metrics = braking_metrics(run, rig)
+    print(metrics_table({run.name: metrics}))
+    _write_braking_outputs(args, run, rig, metrics)
+    return 0
+
+
+def cmd_antiskid(args: argparse.Namespace) -> int:
+    from antiskid.closed_loop import (
+        closed_loop,
+        constant_pressure_baseline,
+        make_controller,
+        with_surface,
+    )
+    from antiskid.metrics import braking_metrics
+    from landing_gear_sim.report.braking import metrics_table
+    from msg_tools.csv_io import write_csv
+
+    rig = with_surface(params_of(args), args.surface)
+    settings = dict(parse_assignment(text) for text in args.setting)
+    step_s = 1.0 / (args.rate or rig.number("simulation.output_rate_hz"))
+    controller = make_controller(args.controller, rig, step_s, settings)
+    progress(f"{args.controller} controller on the {args.surface} surface, closed loop")
+    run = closed_loop(rig, controller, args.rate or 0.0).to_run()
+    run = dataclasses.replace(run, name=f"{args.controller}_{args.surface}")
+    metrics = braking_metrics(run, rig)
+    progress("constant-pressure baseline just below the skid pressure (bisection)")
+    pressure, baseline = constant_pressure_baseline(rig)
+    rows = {run.name: metrics,
+            f"constant {pressure / PA_PER_BAR:.1f} bar": braking_metrics(baseline.to_run(), rig)}
+    print(metrics_table(rows))
+    if metrics.cycling_near_gear_walk:
+        print(f"WARNING: pressure cycles at {metrics.cycling_frequency_hz:.1f} Hz, near the "
+              f"gear-walk resonance ({metrics.gear_walk_frequency_hz:.1f} Hz)")
+    output = args.output or Path("out") / f"{run.name}.csv"
+    output.parent.mkdir(parents=True, exist_ok=True)
+    write_csv(run, output)
+    print(f"  csv:  {output}")
+    _write_braking_outputs(args, run, rig, metrics, output.with_suffix(".png"))
+    return 0
+
+
+def _write_braking_outputs(args: argparse.Namespace, run: Run, rig: RigParameters,
+                           metrics: BrakingMetrics, default_plot: Path | None = None) -> None:
+    import json
+
+    from antiskid.metrics import slip_from, speeds_m_s
+    from landing_gear_sim.report.braking import plot_braking
+
+    if args.json:
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text(json.dumps(metrics.to_dict(), indent=1))
+        print(f"  json: {args.json}")
+    plot = args.plot or default_plot
+    if plot is not None:
+        vehicle, wheel = speeds_m_s(run, rig)
+        path = plot_braking(run, slip_from(vehicle, wheel), wheel, vehicle, metrics, plot)
+        print(f"  plot: {path}")
+
+

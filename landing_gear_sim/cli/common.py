@@ -1,0 +1,83 @@
+"""What the commands share: parameters, progress lines, run options, safe writes."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+from landing_gear_sim.model.parameters import (
+    ELEMENTS,
+    RigParameters,
+    load_parameters,
+    parse_assignment,
+)
+from landing_gear_sim.model.runspec import PROFILES, RunSpec
+from msg_tools.csv_io import Mapping
+from msg_tools.units import PA_PER_BAR
+
+PROG = "landing-gear-sim"
+
+
+def progress(message: str) -> None:
+    """One progress line on stderr (stdout carries the results)."""
+    print(f"[{PROG}] {message}", file=sys.stderr, flush=True)
+
+
+def add_params_arguments(parser: argparse.ArgumentParser, without: bool = True) -> None:
+    parser.add_argument("--config", action="append", type=Path, metavar="FILE",
+                        help="ROS 2 params file; repeat to layer (default: bundled reference rig)")
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="override one parameter, e.g. --set friction.theta1=0.8")
+    if without:
+        parser.add_argument("--without", action="append", default=[], choices=ELEMENTS,
+                            metavar="ELEMENT",
+                            help=f"switch an element off ({', '.join(ELEMENTS)})")
+
+
+def add_run_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--profile", choices=[*PROFILES, "file"], default="constant",
+                        help="valve current profile (default: constant)")
+    parser.add_argument("--pressure-bar", type=float, default=30.0,
+                        help="constant profile: target pressure (default 30 bar)")
+    parser.add_argument("--current-a", type=float, help="constant profile: current instead")
+    parser.add_argument("--file", type=Path,
+                        help="--profile file: run (CSV or bag) whose current to use")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--actuator-only", action="store_true", help="wheel off the flywheel")
+    where.add_argument("--rig", action="store_true", help="wheel on the flywheel")
+    parser.add_argument("--duration", type=float, help="input duration [s] (actuator tests)")
+    parser.add_argument("--rate", type=float, help="output rate [Hz] (default from config)")
+
+
+def params_of(args: argparse.Namespace) -> RigParameters:
+    """The parameter set of ``--config``, ``--set`` and ``--without``."""
+    overrides = dict(parse_assignment(text) for text in args.set)
+    params = load_parameters(args.config, overrides or None)
+    removed = getattr(args, "without", None)
+    return params.without(*removed) if removed else params
+
+
+def run_spec_of(args: argparse.Namespace) -> RunSpec:
+    """The run of the ``--profile`` options."""
+    contact = "actuator" if args.actuator_only else "rig" if args.rig else "auto"
+    return RunSpec(profile=args.profile, pressure_pa=args.pressure_bar * PA_PER_BAR,
+                   current_a=math.nan if args.current_a is None else args.current_a,
+                   file=str(args.file or ""), contact=contact,
+                   duration_s=args.duration or 0.0, rate_hz=args.rate or 0.0)
+
+
+def mapping_of(args: argparse.Namespace) -> Mapping | None:
+    from msg_tools.csv_io import read_mapping
+
+    return read_mapping(args.mapping) if getattr(args, "mapping", None) else None
+
+
+def write_atomically(path: Path, write: Callable[[Path], None]) -> None:
+    """Write via a temporary file so a failure never leaves a half-written ``path``."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".part")
+    write(tmp)
+    tmp.replace(path)

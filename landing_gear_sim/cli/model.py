@@ -1,0 +1,246 @@
+"""The model and graph commands: simulate, rig, bode, params, campaign, convert."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from landing_gear_sim.cli.common import (
+    PROG,
+    add_params_arguments,
+    add_run_arguments,
+    mapping_of,
+    params_of,
+    progress,
+    run_spec_of,
+)
+from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.model.parameters import SPECS
+from landing_gear_sim.model.runspec import RunSpec
+from msg_tools.units import PA_PER_BAR
+
+if TYPE_CHECKING:
+    from landing_gear_sim.model.integrate import SimulationResult
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    """Add the sub-commands of this module to the ``landing-gear-sim`` parser."""
+    sim = sub.add_parser("simulate", help="simulate a rig test; write CSV (+ bag) and a plot")
+    add_params_arguments(sim)
+    add_run_arguments(sim)
+    sim.add_argument("--noise-seed", type=int, help="seed of the sensor noise (sensors.*)")
+    sim.add_argument("-o", "--output", type=Path, help="CSV path (default out/<name>.csv)")
+    sim.add_argument("--bag", type=Path, help="also write a rosbag2 folder here")
+    sim.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
+    sim.add_argument("--plot", type=Path, help="PNG path (default next to the CSV)")
+    sim.add_argument("--no-plot", action="store_true")
+    sim.set_defaults(func=cmd_simulate)
+
+    rig = sub.add_parser("rig", help="bring the ROS 2 node graph up for one run; record a bag")
+    add_params_arguments(rig)
+    add_run_arguments(rig)
+    rig.add_argument("--replay", type=Path, metavar="RUN",
+                     help="re-run a recorded rig test: its current drives the simulated graph")
+    rig.add_argument("--controller", choices=["threshold", "slip"],
+                     help="anti-skid controller in closed loop instead of a profile")
+    rig.add_argument("--clock", choices=["lockstep", "realtime"], default="lockstep",
+                     help="lockstep: sim time, deterministic (default); realtime: wall clock")
+    rig.add_argument("--bag", type=Path, help="bag folder (default out/rig/<run>_<time>)")
+    rig.add_argument("--no-bag", action="store_true", help="run without the recorder")
+    rig.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
+    rig.add_argument("--noise", action="store_true", help="add the sensors.* noise")
+    rig.add_argument("--timeout", type=float, default=10.0,
+                     help="lockstep: seconds to wait for a silent node before holding its input")
+    rig.add_argument("--safe-pressure-bar", type=float, default=0.0,
+                     help="brake pressure applied once the actuator is lost (default 0)")
+    rig.set_defaults(func=cmd_rig)
+
+    bode = sub.add_parser("bode", help="frequency responses G_lambda, G_eta (paper Fig. 7)")
+    add_params_arguments(bode)
+    bode.add_argument("--speeds", type=float, nargs="+", default=[10.0, 30.0, 60.0],
+                      help="operating speeds [m/s]")
+    bode.add_argument("--slip", type=float, default=0.05, help="operating slip (default 0.05)")
+    bode.add_argument("--fmin", type=float, default=0.1)
+    bode.add_argument("--fmax", type=float, default=100.0)
+    bode.add_argument("-o", "--output", type=Path, default=Path("out/bode.png"))
+    bode.set_defaults(func=cmd_bode)
+
+    show = sub.add_parser("params", help="show (or write) the effective parameter set")
+    add_params_arguments(show)
+    show.add_argument("--write", type=Path, help="write the merged set as a params file")
+    show.set_defaults(func=cmd_params)
+
+    gen = sub.add_parser("campaign", help="generate a synthetic rig campaign (own generator)")
+    gen.add_argument("output", type=Path, help="new folder for the runs")
+    add_params_arguments(gen)
+    gen.add_argument("--seed", type=int, default=1)
+    gen.add_argument("--deviation", type=float, default=0.03,
+                     help="largest relative deviation of the rig from the datasheet")
+    gen.set_defaults(func=cmd_campaign)
+
+    conv = sub.add_parser("convert", help="convert a run between CSV and rosbag2")
+    conv.add_argument("input", type=Path)
+    conv.add_argument("output", type=Path, help="*.csv, or a bag folder")
+    conv.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
+    conv.add_argument("--mapping", type=Path, help="column-mapping file for a CSV input")
+    conv.set_defaults(func=cmd_convert)
+
+
+def _summary(result: SimulationResult) -> str:
+    peak_bar = result.pressure_pa.max() / PA_PER_BAR
+    lines = [f"{result.scenario.name}: {len(result)} samples, {result.time_s[-1]:.3f} s "
+             f"({result.stop_reason}); max pressure {peak_bar:.2f} bar"]
+    if result.scenario.contact:
+        braking = result.pressure_pa > 0.1 * PA_PER_BAR
+        locked = (result.wheel_speed_rad_s <= 0) & braking
+        lines.append(f"  speed {result.speed_m_s[0]:.2f} -> {result.speed_m_s[-1]:.2f} m/s, "
+                     f"max slip {result.slip[braking].max() if braking.any() else 0.0:.3f}, "
+                     f"wheel locked {locked.sum() / result.scenario.rate_hz:.3f} s")
+    return "\n".join(lines)
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    from landing_gear_sim.model.integrate import simulate
+    from landing_gear_sim.report.figures import plot_simulation
+    from landing_gear_sim.ros.graph import load_scenario
+    from msg_tools.bag_io import write_bag
+    from msg_tools.csv_io import write_csv
+
+    if args.bag and args.bag.exists():  # fail before anything is written
+        raise LandingGearSimError(f"{args.bag}: exists already; remove it or choose another --bag")
+    params = params_of(args)
+    if args.profile == "file" and args.file is None:
+        raise LandingGearSimError("--profile file needs --file RUN")
+    scenario = load_scenario(run_spec_of(args), params)
+    progress(f"simulating {scenario.name} (up to {scenario.duration_s:.1f} s at "
+              f"{scenario.rate_hz:g} Hz; the first run compiles the physics, ~10 s)")
+    started = time.perf_counter()
+    result = simulate(params, scenario)
+    progress(f"simulated in {time.perf_counter() - started:.2f} s")
+    output = args.output or Path("out") / f"{scenario.name}.csv"
+    output.parent.mkdir(parents=True, exist_ok=True)
+    run = result.to_run(np.random.default_rng(args.noise_seed))  # noise as sensors.* says
+    write_csv(run, output)
+    print(_summary(result))
+    print(f"  csv:  {output}")
+    if args.bag:
+        write_bag(run, args.bag, args.storage)
+        print(f"  bag:  {args.bag} ({args.storage})")
+    if not args.no_plot:
+        plot = plot_simulation(result, args.plot or output.with_suffix(".png"))
+        print(f"  plot: {plot}")
+    return 0
+
+
+def cmd_rig(args: argparse.Namespace) -> int:
+    from landing_gear_sim.ros.graph import GraphOptions, controlled_run, load_scenario
+    from landing_gear_sim.ros.launcher import run_graph
+
+    params = params_of(args)
+    spec = run_spec_of(args)
+    if args.replay is not None:
+        spec = RunSpec(profile="file", file=str(args.replay), contact=spec.contact,
+                       rate_hz=spec.rate_hz)
+    spec = controlled_run(spec, args.controller)
+    scenario = load_scenario(spec, params)  # fail here, not in five processes
+    bag = None if args.no_bag else args.bag or Path("out") / "rig" / (
+        f"{scenario.name}_{time.strftime('%Y%m%d-%H%M%S')}")
+    if bag is not None and bag.exists():
+        raise LandingGearSimError(f"{bag}: exists already; remove it or choose another --bag")
+    options = GraphOptions(run=spec, clock=args.clock, bag=bag, storage=args.storage,
+                           sensor_noise=args.noise, timeout_s=args.timeout,
+                           safe_pressure_pa=args.safe_pressure_bar * PA_PER_BAR,
+                           replay=args.replay is not None, controller=args.controller)
+    progress(f"{scenario.name}: {args.clock} graph, up to {scenario.duration_s:.1f} s at "
+              f"{scenario.rate_hz:g} Hz")
+    started = time.perf_counter()
+    outcome = run_graph(options, params, progress)
+    wall = time.perf_counter() - started
+    print(f"graph run: {wall:.1f} s wall; node exit codes: "
+          + ", ".join(f"{name} {code}" for name, code in outcome.exit_codes.items()))
+    if bag is not None:
+        print(_bag_summary(bag))
+    if outcome.interrupted:
+        print(f"{PROG}: interrupted; the bag holds the run up to the stop", file=sys.stderr)
+        return 130
+    return 0 if outcome.ok else 1
+
+
+def _bag_summary(bag: Path) -> str:
+    from msg_tools.bag_io import read_bag
+    from msg_tools.errors import RunFormatError
+
+    try:
+        run = read_bag(bag)
+    except RunFormatError as exc:
+        return f"bag: {bag} (not readable as a run: {exc})"
+    return (f"bag: {bag} ({len(run)} samples, {run.time_s[-1]:.3f} s, max pressure "
+            f"{run.pressure_pa.max() / PA_PER_BAR:.2f} bar, flywheel "
+            f"{run.flywheel_speed_rad_s[0]:.1f} -> {run.flywheel_speed_rad_s[-1]:.1f} rad/s)")
+
+
+def cmd_bode(args: argparse.Namespace) -> int:
+    from landing_gear_sim.model.linear import frequency_response, resonance_hz
+    from landing_gear_sim.report.figures import plot_bode
+
+    params = params_of(args)
+    frequencies = np.logspace(np.log10(args.fmin), np.log10(args.fmax), 800)
+    variants = [params] if not params.has("gear_walk") else [params, params.without("gear_walk")]
+    responses = [frequency_response(v, speed, frequencies, args.slip)
+                 for speed in args.speeds for v in variants]
+    for response in responses:
+        peak = resonance_hz(response)
+        where = f"resonance {peak:.2f} Hz" if peak else "no resonance"
+        print(f"{response.speed_m_s:6.1f} m/s, {'with' if response.gear_walk else 'without'} "
+              f"gear walk: |G_lambda(0)| = {abs(response.slip[0]):.3g} 1/(N m), {where}")
+    print(f"plot: {plot_bode(responses, args.output)}")
+    return 0
+
+
+def cmd_params(args: argparse.Namespace) -> int:
+    params = params_of(args)
+    if args.write:
+        params.to_yaml(args.write)
+        print(f"wrote {args.write}")
+        return 0
+    print(f"# from: {', '.join(params.sources)}")
+    for spec in SPECS:
+        print(f"{spec.key:40s} {params[spec.key]!s:>14}  [{spec.unit}]  {spec.description}")
+    return 0
+
+
+def cmd_campaign(args: argparse.Namespace) -> int:
+    from landing_gear_sim.calibration.campaign import GENERATING_FILE, generate_campaign, rig_like
+
+    if args.output.exists() and any(args.output.iterdir()):
+        raise LandingGearSimError(f"{args.output}: exists and is not empty, not overwriting")
+    rig = rig_like(params_of(args), np.random.default_rng(args.seed), args.deviation)
+    progress(f"simulating a synthetic campaign (seed {args.seed}, datasheet "
+              f"±{100 * args.deviation:g} %)")
+    for path in generate_campaign(args.output, rig, args.seed):
+        print(f"  {path}")
+    print(f"generating parameters (for checks only): {args.output / GENERATING_FILE}")
+    return 0
+
+
+def cmd_convert(args: argparse.Namespace) -> int:
+    from msg_tools.bag_io import write_bag
+    from msg_tools.csv_io import write_csv
+    from msg_tools.io import read_run
+
+    run = read_run(args.input, mapping_of(args))
+    if args.output.exists():
+        raise LandingGearSimError(f"{args.output}: exists already, not overwriting")
+    if args.output.suffix == ".csv":
+        write_csv(run, args.output)
+    else:
+        write_bag(run, args.output, args.storage)
+    print(f"{args.input} -> {args.output} ({len(run)} samples)")
+    return 0
+
+

@@ -1,0 +1,80 @@
+"""What a diagnosis finds: causes with their evidence, and residual structure."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+
+class SignatureKind(str, enum.Enum):
+    """What a residual signature measures (compares equal to its value)."""
+
+    FREQUENCY = "frequency"
+    LAG = "lag"
+    REGRESSOR = "regressor"
+
+    def __str__(self) -> str:
+        return self.value
+
+    @property
+    def parameter(self) -> str:
+        """Its key parameter's name in an ``unexplained`` finding."""
+        return {"frequency": "frequency_hz", "lag": "lag_s", "regressor": "correlation"}[
+            self.value]
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One cause (or unexplained structure) with its evidence.
+
+    ``parameters`` are the key parameters (contract names, SI) and ``std`` their
+    1-σ; ``fit_before``/``fit_after`` are fit % per channel on the held-out runs;
+    ``delta_bic`` is BIC(with) − BIC(without) on the fitting runs (negative favours
+    the extension) and ``held_out`` the same log-likelihood change on held-out runs.
+    """
+
+    cause: str
+    parameters: dict[str, float]
+    std: dict[str, float]
+    evidence: str
+    fit_before: dict[str, float]
+    fit_after: dict[str, float]
+    delta_bic: float | None
+    held_out: float | None
+    accepted: bool
+    fitted_on: tuple[str, ...] = ()
+    checked_on: tuple[str, ...] = ()
+
+    def to_json(self) -> dict[str, object]:
+        return {"cause": self.cause, "parameters": self.parameters,
+                "uncertainty": self.std, "evidence": self.evidence,
+                "fit_before": self.fit_before, "fit_after": self.fit_after,
+                "delta_bic": self.delta_bic, "held_out_delta": self.held_out,
+                "fitted_on": list(self.fitted_on), "checked_on": list(self.checked_on)}
+
+
+@dataclass(frozen=True)
+class Signature:
+    """Structure in the residual that recurs across runs.
+
+    ``kind`` says what ``value`` is: a frequency [Hz], a lag [s, positive: measurement
+    later] or a correlation with the named ``regressor``; ``size`` compares it with the
+    noise (peak power over floor; lag in samples; |correlation| over its band).
+    """
+
+    kind: SignatureKind
+    channel: str
+    value: float
+    size: float
+    runs: tuple[str, ...]
+    regressor: str = ""
+
+    def describe(self) -> str:
+        where = f"{self.channel} residual in {len(self.runs)} runs"
+        if self.kind is SignatureKind.FREQUENCY:
+            return f"spectral line at {self.value:.2f} Hz ({self.size:.0f}x the floor) in {where}"
+        if self.kind is SignatureKind.LAG:
+            return (f"measured {self.channel} lags the simulation by {self.value * 1e3:.1f} ms"
+                    f" in {len(self.runs)} runs")
+        return (f"{where} correlates with {self.regressor} (r = {self.value:+.2f}, "
+                f"{self.size:.1f}x its noise band)")

@@ -1,0 +1,189 @@
+"""Scoring a candidate: fit it and its null on some runs, check both on the others.
+
+ΔBIC = n_eff ln(RSS_candidate / RSS_null) + k ln(n_eff), with n_eff the sample count
+corrected for the residual's autocorrelation (simulation errors are smooth: 1 kHz
+samples are far from independent). A candidate is accepted only if ΔBIC < BIC_THRESHOLD
+*and* it also improves runs it was not fitted on by HELD_OUT_THRESHOLD (same
+log-likelihood measure, no penalty: nothing was fitted there) by at least
+MIN_GAIN_POINTS of fit, with no key parameter at the edge of its range.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from landing_gear_sim.calibration.measured import simulate_all
+from landing_gear_sim.calibration.runs import (
+    ClassifiedRun,
+    RunKind,
+    classify_all,
+    family_of,
+    select,
+)
+from landing_gear_sim.diagnosis.catalogue import (
+    Candidate,
+    CandidateFit,
+    Scales,
+    fit_candidate,
+    key_parameters,
+    scaled_error,
+)
+from landing_gear_sim.diagnosis.findings import Finding, Signature
+from landing_gear_sim.model.parameters import RigParameters
+from msg_tools.run import Run
+
+BIC_THRESHOLD = -10.0  # "very strong" evidence (Kass & Raftery 1995)
+HELD_OUT_THRESHOLD = -10.0
+# ... and worth having: mean held-out fit gain over the compared channels [% points]
+MIN_GAIN_POINTS = 0.1
+
+
+def channel_fits(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequence[str]
+                 ) -> dict[str, float]:
+    """Fit % per channel of ``simulated`` against ``runs``, pooled (each run's own mean
+    removed)."""
+    errors: dict[str, float] = dict.fromkeys(channels, 0.0)
+    spreads: dict[str, float] = dict.fromkeys(channels, 0.0)
+    for run, sim in zip(runs, simulated, strict=True):
+        for c in channels:
+            y = getattr(run, c)
+            errors[c] += float(np.sum((y - getattr(sim, c)) ** 2))
+            spreads[c] += float(np.sum((y - y.mean()) ** 2))
+    return {c: round(100.0 * (1.0 - math.sqrt(errors[c] / spreads[c])), 2)
+            for c in channels if spreads[c] > 0}
+
+
+def effective_count(residual: np.ndarray) -> float:
+    """Samples worth of independent information: n (1 − ρ₁)/(1 + ρ₁) (AR(1) residual)."""
+    r = residual - residual.mean()
+    rho = float(np.clip(r[1:] @ r[:-1] / (r @ r), 0.0, 0.999)) if r @ r > 0 else 0.0
+    return max(len(r) * (1 - rho) / (1 + rho), 2.0)
+
+
+def log_ratio(candidate: np.ndarray, null: np.ndarray) -> float:
+    """n_eff ln(RSS_candidate / RSS_null), n_eff from the null's residual."""
+    return effective_count(null) * math.log(float(candidate @ candidate) / float(null @ null))
+
+
+def split_runs(candidate: Candidate, runs: Sequence[Run]
+               ) -> tuple[list[ClassifiedRun], list[ClassifiedRun]]:
+    """Runs to fit the candidate on, and runs kept to check it.
+
+    Actuator effects are checked on the braking runs' pressure. Otherwise the runs
+    of each class are sorted by length and alternate between the two sets (the
+    shorter to fitting), so both see every kind of test.
+    """
+    classified = classify_all(runs)
+    own = select(classified, candidate.runs) or select(
+        classified, [family_of(kind) for kind in candidate.runs])
+    others = select(classified, candidate.held_out)
+    if own and others:
+        return own, others
+    fit: list[ClassifiedRun] = []
+    held: list[ClassifiedRun] = []
+    by_class: dict[RunKind, list[ClassifiedRun]] = {}
+    for r in own or others:
+        by_class.setdefault(r.kind, []).append(r)
+    for members in by_class.values():
+        for i, r in enumerate(sorted(members, key=len)):
+            (fit if i % 2 == 0 else held).append(r)
+    return fit, held
+
+
+@dataclass(frozen=True)
+class Scored:
+    """A scored candidate: its finding and its fit."""
+
+    finding: Finding
+    fit: CandidateFit
+
+
+def _names(runs: Sequence[Run]) -> tuple[str, ...]:
+    return tuple(r.name for r in runs)
+
+
+def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParameters,
+                    datasheet: RigParameters, scales: Scales,
+                    signatures: Sequence[Signature]) -> Scored:
+    """Fit ``candidate`` and its null on the fitting runs; compare both on held-out runs."""
+    fit_runs, held_runs = split_runs(candidate, runs)
+    sub = _as_fitting(candidate, fit_runs)
+    with_it = fit_candidate(sub, fit_runs, model, datasheet, scales=scales)
+    without = fit_candidate(sub, fit_runs, model, datasheet, null=True, scales=scales)
+    k = len(candidate.keys)
+    n_eff = effective_count(without.residual)
+    delta_bic = log_ratio(with_it.residual, without.residual) + k * math.log(n_eff)
+    held_delta = None
+    before: dict[str, float] = {}
+    after: dict[str, float] = {}
+    if held_runs:
+        channels = candidate.channels
+        sim_with = simulate_all(held_runs, with_it.params)
+        sim_without = simulate_all(held_runs, without.params)
+        held_delta = log_ratio(scaled_error(held_runs, sim_with, channels, scales),
+                               scaled_error(held_runs, sim_without, channels, scales))
+        before = channel_fits(held_runs, sim_without, channels)
+        after = channel_fits(held_runs, sim_with, channels)
+    gain = float(np.mean([after[c] - before[c] for c in after])) if after else 0.0
+    at_bound = _at_bound(candidate, with_it)
+    accepted = (delta_bic < BIC_THRESHOLD and held_delta is not None
+                and held_delta < HELD_OUT_THRESHOLD and gain >= MIN_GAIN_POINTS
+                and not at_bound)
+    parameters = key_parameters(candidate, with_it.params)
+    std = key_std(candidate, with_it)
+    finding = Finding(candidate.cause, parameters, std,
+                      _evidence(candidate, delta_bic, held_delta, before, after, fit_runs,
+                                held_runs, signatures)
+                      + ("; a key parameter sits at the edge of its range" if at_bound else ""),
+                      before, after, round(delta_bic, 1),
+                      None if held_delta is None else round(held_delta, 1), accepted,
+                      _names(fit_runs), _names(held_runs))
+    return Scored(finding, with_it)
+
+
+def _at_bound(candidate: Candidate, fit: CandidateFit) -> bool:
+    """A key pinned to the edge of its range: the data want the element off (or more
+    than it can give) — not evidence for it."""
+    for key, (low, high) in zip(candidate.keys, candidate.bounds, strict=True):
+        margin = 0.01 * (high - low)
+        if not low + margin < fit.values[key] < high - margin:
+            return True
+    return False
+
+
+def _as_fitting(candidate: Candidate, runs: Sequence[ClassifiedRun]) -> Candidate:
+    """The candidate fitted on the families of ``runs`` (its own kinds, or when the
+    campaign has none of those, the kinds it is otherwise checked on)."""
+    families = tuple(sorted({r.kind.family for r in runs}, key=lambda f: f.value))
+    return replace(candidate, runs=families)
+
+
+def key_std(candidate: Candidate, fit: CandidateFit) -> dict[str, float]:
+    if candidate.cause == "gear_walk":
+        k, c = (fit.values[key] for key in candidate.keys)
+        sk, sc = (fit.std[key] for key in candidate.keys)
+        keys = key_parameters(candidate, fit.params)
+        return {"frequency_hz": keys["frequency_hz"] * sk / (2 * k),
+                "damping_ratio": keys["damping_ratio"] * math.hypot(sc / c, sk / (2 * k))}
+    return {name: fit.std.get(key, 0.0) for name, key in candidate.contract}
+
+
+def _evidence(candidate: Candidate, delta_bic: float, held: float | None,
+              before: dict[str, float], after: dict[str, float], fit_runs: Sequence[Run],
+              held_runs: Sequence[Run], signatures: Sequence[Signature]) -> str:
+    words = [f"fitted on {len(fit_runs)} runs ({', '.join(candidate.channels)}): "
+             f"ΔBIC {delta_bic:+.0f} against the same base parameters re-fitted without it"]
+    if held is None:
+        words.append("no run left to check it on")
+    else:
+        gains = ", ".join(f"{c} {before[c]:.1f} → {after[c]:.1f} %" for c in after)
+        words.append(f"on {len(held_runs)} held-out runs: {gains} "
+                     f"(log-likelihood change {held:+.0f})")
+    related = [s.describe() for s in signatures if s.channel in candidate.channels]
+    if related:
+        words.append("residual before: " + "; ".join(related[:2]))
+    return "; ".join(words)

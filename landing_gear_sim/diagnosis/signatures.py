@@ -1,0 +1,160 @@
+"""Residual signatures: structure in the residuals of a model that recurs across runs.
+
+Spectral lines of the pressure and wheel-speed residuals over the running-median floor
+(:mod:`~landing_gear_sim.diagnosis.residuals`), a pressure lag consistent over the runs,
+and a wheel-speed residual correlated with load, speed, slip, pressure, brake energy or
+pressure direction in most runs. What the final model leaves is reported as an
+``unexplained`` finding with its signature, never given a name.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
+from landing_gear_sim.diagnosis import residuals as rs
+from landing_gear_sim.diagnosis.findings import Finding, Signature, SignatureKind
+from landing_gear_sim.model.elements import slip_ratio
+from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.quantities import rim_speed_m_s
+from msg_tools.run import Run
+from msg_tools.units import PA_PER_BAR
+
+LINE_SIZE = 30.0  # a spectral line this far over the floor is structure, not noise
+LAG_SAMPLES = 1.0  # a consistent lag of a sample or more
+CORRELATION = 0.3  # |r| of the residual with a regressor ...
+CORRELATION_BANDS = 3.0  # ... and that many times its noise band
+# below 2 Hz a mis-calibrated model leaves a smooth trend, not a line
+LINE_BAND_HZ = (2.0, 200.0)
+MIN_SPECTRUM_SAMPLES = 2048  # one Welch segment: a shorter window shows no line
+LAG_PRESSURE_SPAN_PA = 5 * PA_PER_BAR  # a run whose pressure moves this much shows a lag
+
+
+def _regressors(run: Run, params: RigParameters) -> dict[str, np.ndarray]:
+    speed = rim_speed_m_s(params, run.flywheel_speed_rad_s)
+    slip = slip_ratio(speed, run.wheel_speed_rad_s, params.number("wheel.unloaded_radius_m"))
+    smooth_pressure = np.convolve(run.pressure_pa, np.ones(20) / 20, mode="same")
+    energy = np.cumsum(np.clip(run.pressure_pa, 0, None) * np.clip(run.wheel_speed_rad_s, 0, None))
+    return {"vertical load": run.vertical_load_n, "speed": speed,
+            "slip": slip, "pressure": run.pressure_pa,
+            "brake energy": energy, "pressure direction": np.sign(np.gradient(smooth_pressure))}
+
+
+@dataclass(frozen=True)
+class RunEvidence:
+    """One run as the diagnosis saw it: measured, simulated by the calibrated starting model
+    (``before``) and by the extended one (``after``), and the starting model's residual
+    spectrum on ``channel`` (wheel speed in a braking run, pressure otherwise; None when the
+    window is too short for one)."""
+
+    run: ClassifiedRun
+    before: Run
+    after: Run
+    channel: str
+    spectrum: rs.Spectrum | None
+
+
+def run_evidence(run: ClassifiedRun, before: Run, after: Run, params: RigParameters
+                 ) -> RunEvidence:
+    """The evidence of one run (``params``: the calibrated starting model of ``before``)."""
+    channel = "wheel_speed_rad_s" if run.braking else "pressure_pa"
+    window = _window(run, params)
+    spectrum = None
+    if window.sum() >= MIN_SPECTRUM_SAMPLES:
+        error = (getattr(run, channel) - getattr(before, channel))[window]
+        spectrum = rs.spectrum(error, run.rate_hz, band_hz=LINE_BAND_HZ)
+    return RunEvidence(run, before, after, channel, spectrum)
+
+
+def _window(run: ClassifiedRun, params: RigParameters) -> np.ndarray:
+    """The samples whose residual carries structure: the braking phase, or all of an
+    actuator run."""
+    return braking_window(run, params) if run.braking else np.ones(len(run), bool)
+
+
+def find_signatures(runs: Sequence[ClassifiedRun], params: RigParameters,
+                    simulated: Sequence[Run]) -> list[Signature]:
+    """Structure of the residuals of ``params`` (``simulated``: the runs simulated with it)
+    that recurs in at least two runs."""
+    lines: dict[str, list[tuple[str, float, float]]] = {}
+    lags: list[tuple[str, float]] = []
+    correlations: dict[str, list[tuple[str, float, float]]] = {}
+    for run, model in zip(runs, simulated, strict=True):
+        channels = ["pressure_pa"] + (["wheel_speed_rad_s"] if run.braking else [])
+        window = _window(run, params)
+        for channel in channels:
+            if window.sum() < MIN_SPECTRUM_SAMPLES:
+                continue
+            error = getattr(run, channel) - getattr(model, channel)
+            for peak in rs.spectrum(error[window], run.rate_hz, band_hz=LINE_BAND_HZ).peaks[:3]:
+                lines.setdefault(channel, []).append((run.name, peak.frequency_hz, peak.ratio))
+            if channel == "wheel_speed_rad_s":
+                for c in rs.regressor_correlations(error[window],
+                                                   {k: v[window] for k, v in
+                                                    _regressors(run, params).items()}):
+                    correlations.setdefault(c.name, []).append((run.name, c.value, c.band))
+        if np.ptp(run.pressure_pa) > LAG_PRESSURE_SPAN_PA:
+            lags.append((run.name, rs.lag_samples(run.pressure_pa, model.pressure_pa, 50)
+                         / run.rate_hz))
+    return [*_recurring_lines(lines), *_consistent_lag(lags, runs),
+            *_consistent_correlations(correlations)]
+
+
+def _recurring_lines(lines: dict[str, list[tuple[str, float, float]]]) -> list[Signature]:
+    out = []
+    for channel, found in lines.items():
+        strong = sorted((f for f in found if f[2] > LINE_SIZE), key=lambda f: -f[2])
+        used: set[int] = set()
+        for i, (_, freq, ratio) in enumerate(strong):
+            if i in used:
+                continue
+            near = [j for j, f in enumerate(strong)
+                    if j not in used and abs(f[1] - freq) <= max(0.5, 0.05 * freq)]
+            names = {strong[j][0] for j in near}
+            used.update(near)
+            if len(names) >= 2:
+                out.append(Signature(SignatureKind.FREQUENCY, channel, freq, ratio,
+                                     tuple(sorted(names))))
+    return out
+
+
+def _consistent_lag(lags: list[tuple[str, float]], runs: Sequence[Run]) -> list[Signature]:
+    if len(lags) < 2:
+        return []
+    values = np.array([v for _, v in lags])
+    rate = float(np.median([r.rate_hz for r in runs]))
+    median = float(np.median(values))
+    same_sign = np.mean(np.sign(values) == np.sign(median))
+    if abs(median) * rate >= LAG_SAMPLES and same_sign >= 0.75:
+        return [Signature(SignatureKind.LAG, "pressure_pa", median, abs(median) * rate,
+                          tuple(n for n, _ in lags))]
+    return []
+
+
+def _consistent_correlations(found: dict[str, list[tuple[str, float, float]]]
+                             ) -> list[Signature]:
+    out = []
+    for name, values in found.items():
+        strong = [(run, r, band) for run, r, band in values
+                  if abs(r) > max(CORRELATION_BANDS * band, CORRELATION)]
+        if len(strong) < 2 or len(strong) < 0.6 * len(values):
+            continue
+        signs = {np.sign(r) for _, r, _ in strong}
+        if len(signs) == 1:
+            r = float(np.mean([r for _, r, _ in strong]))
+            size = float(np.mean([abs(r) / band for _, r, band in strong]))
+            out.append(Signature(SignatureKind.REGRESSOR, "wheel_speed_rad_s", r, size,
+                                 tuple(run for run, _, _ in strong), name))
+    return sorted(out, key=lambda s: -abs(s.value))
+
+
+def unexplained(signatures: Sequence[Signature], baseline: dict[str, float]) -> Finding:
+    """The strongest remaining signature as an ``unexplained`` finding."""
+    best = signatures[0]
+    return Finding("unexplained", {best.kind.parameter: round(best.value, 6)}, {},
+                   "no candidate of the catalogue explains: "
+                   + "; ".join(s.describe() for s in signatures[:3]),
+                   baseline, baseline, None, None, False, best.runs, ())

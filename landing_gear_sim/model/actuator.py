@@ -1,0 +1,137 @@
+"""The actuator block: the valve's static map, then A(s), with an optional transport delay.
+
+The static map is :func:`landing_gear_sim.model.elements.valve_map`; A(s) is the unit
+second-order lag μ ω_n² / (s² + 2 ξ ω_n s + ω_n²) of eq. (10), written once as a state
+space (:func:`second_order_system`) from which come the exact discretisation the
+plant steps (:func:`actuator_matrices`), the frequency response identification fits
+(:func:`second_order_response`) and the continuous equations of the reference solution.
+State: pressure [Pa] and its rate [Pa/s], driven by the static-map pressure [Pa].
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.linalg
+from numba import njit
+
+from landing_gear_sim.model import elements as el
+from landing_gear_sim.model.parameters import INDEX, RigParameters
+
+_ACT_GAIN = INDEX["actuator.gain"]
+_ACT_WN = INDEX["actuator.natural_frequency_hz"]
+_ACT_ZETA = INDEX["actuator.damping_ratio"]
+_ACT_DELAY = INDEX["actuator.delay_s"]
+
+
+def second_order_system(natural_frequency_hz: float, damping_ratio: float, gain: float
+                        ) -> tuple[np.ndarray, np.ndarray]:
+    """A(s) as ẋ = a x + b u, x = (pressure [Pa], rate [Pa/s]), u the static-map pressure
+    [Pa]; shapes (2, 2) and (2,)."""
+    wn = 2.0 * math.pi * natural_frequency_hz
+    a = np.array([[0.0, 1.0], [-wn * wn, -2.0 * damping_ratio * wn]])
+    b = np.array([0.0, gain * wn * wn])
+    return a, b
+
+
+def second_order_response(frequency_hz: np.ndarray, natural_frequency_hz: float,
+                          damping_ratio: float, gain: float) -> np.ndarray:
+    """A(j 2π f) at each frequency [Hz] (complex, shape of ``frequency_hz``), from the same
+    state space the plant steps."""
+    a, b = second_order_system(natural_frequency_hz, damping_ratio, gain)
+    s = 2j * np.pi * np.asarray(frequency_hz, dtype=float)
+    resolvent = s[..., None, None] * np.eye(2) - a
+    return np.linalg.solve(resolvent, np.broadcast_to(b, (*s.shape, 2))[..., None])[..., 0, 0]
+
+
+def actuator_system(params: RigParameters) -> tuple[np.ndarray, np.ndarray]:
+    """A(s) of a parameter set (see :func:`second_order_system`)."""
+    return second_order_system(params.number("actuator.natural_frequency_hz"),
+                               params.number("actuator.damping_ratio"),
+                               params.number("actuator.gain"))
+
+
+def _zoh(a: np.ndarray, b: np.ndarray, span_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Φ = e^{A T}, Γ = ∫₀ᵀ e^{A s} ds B for an input held over ``span_s``."""
+    augmented = np.zeros((3, 3))
+    augmented[:2, :2], augmented[:2, 2] = a, b
+    m = scipy.linalg.expm(augmented * span_s)
+    return m[:2, :2], m[:2, 2]
+
+
+ACT_DELAY_STEPS = 8  # position of the whole-step delay in the actuator matrices
+
+
+def actuator_matrices(params_vector: np.ndarray, step_s: float) -> np.ndarray:
+    """Exact discretisation of A(s) with the held input delayed by ``actuator.delay_s``.
+
+    With the delay d = (m + f)·h, the input seen over step k is u_{k−m−1} for f·h,
+    then u_{k−m} for (1−f)·h, so x_{k+1} = Φ_h x_k + G0 u_{k−m} + G1 u_{k−m−1} with
+    G0 = Γ_{(1−f)h} and G1 = Φ_{(1−f)h} Γ_{fh}. Returns
+    ``[Φ00, Φ01, Φ10, Φ11, G0₀, G0₁, G1₀, G1₁, m]`` for the state (pressure [Pa],
+    rate [Pa/s]) driven by the static-map pressure.
+    """
+    p = params_vector
+    a, b = second_order_system(p[_ACT_WN], p[_ACT_ZETA], p[_ACT_GAIN])
+    delay = p[_ACT_DELAY] if p[el.HAS_ACTUATOR_DELAY] else 0.0
+    steps = delay / step_s
+    whole = math.floor(steps + 1e-9)
+    fraction = steps - whole if steps - whole > 1e-9 else 0.0
+    phi, gamma = _zoh(a, b, step_s)
+    if fraction == 0.0:
+        g0, g1 = gamma, np.zeros(2)
+    else:
+        phi_late, g0 = _zoh(a, b, (1.0 - fraction) * step_s)
+        g1 = phi_late @ _zoh(a, b, fraction * step_s)[1]
+    return np.concatenate([phi.ravel(), g0, g1, [float(whole)]])
+
+
+@njit(cache=True)
+def actuator_state(matrices):
+    """Zero actuator state: pressure, rate, then the static pressures of recent steps."""
+    return np.zeros(2 + int(matrices[ACT_DELAY_STEPS]) + 2)
+
+
+@njit(cache=True)
+def actuator_step(p, matrices, xa, current_a):
+    """Advance the actuator state ``xa`` one step with ``current_a`` held; return P [Pa]."""
+    for j in range(xa.size - 1, 2, -1):  # shift register of static-map pressures
+        xa[j] = xa[j - 1]
+    xa[2] = el.valve_static_pressure(p, current_a)
+    whole = int(matrices[ACT_DELAY_STEPS])
+    newer, older = xa[2 + whole], xa[3 + whole]
+    if p[el.HAS_ACTUATOR_DYNAMICS] == 0.0:
+        xa[0], xa[1] = p[_ACT_GAIN] * newer, 0.0
+        return xa[0]
+    m = matrices
+    x0, x1 = xa[0], xa[1]
+    xa[0] = m[0] * x0 + m[1] * x1 + m[4] * newer + m[6] * older
+    xa[1] = m[2] * x0 + m[3] * x1 + m[5] * newer + m[7] * older
+    return xa[0]
+
+
+@njit(cache=True)
+def settled_response(p, matrices, current):
+    """Pressure [Pa] for a held current sequence, starting in steady state at the first
+    current (A(s) is stable: the state settles on that level first)."""
+    xa = actuator_state(matrices)
+    xa[0] = actuator_step(p, matrices, xa, current[0])
+    for _ in range(100000):
+        before = xa[0]
+        actuator_step(p, matrices, xa, current[0])
+        if abs(xa[0] - before) < 1e-9 and abs(xa[1]) < 1e-6:
+            break
+    out = np.empty(current.size)
+    out[0] = xa[0]
+    for k in range(current.size - 1):
+        out[k + 1] = actuator_step(p, matrices, xa, current[k])
+    return out
+
+
+def actuator_pressure(params: RigParameters, current_a: np.ndarray, rate_hz: float
+                      ) -> np.ndarray:
+    """Model pressure [Pa] for a held current sequence [A] at ``rate_hz``, from steady
+    state at the first level; shape of ``current_a``."""
+    vector = params.vector()
+    return settled_response(vector, actuator_matrices(vector, 1.0 / rate_hz), current_a)

@@ -1,0 +1,68 @@
+"""The model's laws evaluated on arrays for one parameter set (calibration, metrics, plots).
+
+Each function here calls the compiled law of :mod:`landing_gear_sim.model.elements`; none
+restates it. Inputs and outputs are numpy arrays of the same shape, SI.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from landing_gear_sim.model import elements as el
+from landing_gear_sim.model.parameters import RigParameters
+
+PEAK_GRID = np.linspace(0.0, 1.0, 20001)  # slip grid on which the friction peak is sought
+
+
+def rolling_radius_at(params: RigParameters, load_n: np.ndarray) -> np.ndarray:
+    """Rolling radius of eq. (9) at each vertical load [N] → [m], same shape; r0 when the
+    ``load_dependent_radius`` element is off. The compiled law itself, once per sample."""
+    vector = params.vector()
+    return np.array([el.rolling_radius(vector, f) for f in np.asarray(load_n, dtype=float)])
+
+
+def friction_at(params: RigParameters, slip: np.ndarray) -> np.ndarray:
+    """Burckhardt μ(λ) of the parameter set at each slip λ ≥ 0 (eq. 11)."""
+    return el.burckhardt_mu(*friction_coefficients(params), np.asarray(slip, dtype=float))
+
+
+def friction_coefficients(params: RigParameters) -> tuple[float, float, float]:
+    """(ϑ1, ϑ2, ϑ3) of the Burckhardt curve."""
+    t1, t2, t3 = (params.number(f"friction.theta{i}") for i in (1, 2, 3))
+    return t1, t2, t3
+
+
+def peak_friction(params: RigParameters) -> tuple[float, float]:
+    """Peak μ of the friction curve and the slip where it occurs."""
+    mu = friction_at(params, PEAK_GRID)
+    best = int(np.argmax(mu))
+    return float(mu[best]), float(PEAK_GRID[best])
+
+
+def rim_speed_m_s(params: RigParameters, flywheel_speed_rad_s: np.ndarray) -> np.ndarray:
+    """Flywheel rim (vehicle) speed ω_f R_f [m/s] from the flywheel encoder [rad/s]."""
+    return flywheel_speed_rad_s * params.number("flywheel.radius_m")
+
+
+def flywheel_speed_rad_s(params: RigParameters, rim_speed: np.ndarray) -> np.ndarray:
+    """Flywheel encoder speed [rad/s] of a rim speed [m/s] (inverse of rim_speed_m_s)."""
+    return rim_speed / params.number("flywheel.radius_m")
+
+
+def slip_at(params: RigParameters, vehicle_speed_m_s: np.ndarray,
+            wheel_speed_rad_s: np.ndarray, load_n: np.ndarray) -> np.ndarray:
+    """Slip λ of eq. (1) with the rolling radius at each load (no gear-walk correction:
+    the vehicle speed stands in for the hub speed)."""
+    radius = rolling_radius_at(params, load_n)
+    return el.slip_ratio(np.asarray(vehicle_speed_m_s, dtype=float),
+                         np.asarray(wheel_speed_rad_s, dtype=float), radius)
+
+
+def gear_walk_modes(params: RigParameters) -> tuple[float, float]:
+    """Gear alone: natural frequency √(k_θ/J)/2π [Hz] and damping ratio c_θ/(2√(k_θ J))."""
+    k = params.number("gear_walk.stiffness_n_m_per_rad")
+    j = params.number("gear_walk.inertia_kg_m2")
+    c = params.number("gear_walk.damping_n_m_s_per_rad")
+    return math.sqrt(k / j) / (2 * math.pi), c / (2 * math.sqrt(k * j))

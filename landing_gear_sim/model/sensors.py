@@ -1,0 +1,61 @@
+"""The rig's sensors: what the transducers read of the true state, written once.
+
+Pressure transducer: the true gauge pressure plus ``sensors.pressure_offset_pa`` when the
+``pressure_sensor_offset`` element is on, plus white noise. Encoders and the load cell:
+the true value plus white noise. Noise is drawn only when a random generator is given
+(``sensors.*_noise_*`` std; 0 means none), so a simulation compared with a measurement
+is never noisy by accident. Values are floats or arrays alike.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TypeVar
+
+import numpy as np
+
+from landing_gear_sim.model.parameters import RigParameters
+
+Value = TypeVar("Value", float, np.ndarray)
+
+
+@dataclass(frozen=True)
+class SensorModel:
+    """Offset [Pa] and noise std (Pa, rad/s, N) of the rig's sensors."""
+
+    pressure_offset_pa: float = 0.0
+    pressure_noise_pa: float = 0.0
+    speed_noise_rad_s: float = 0.0
+    force_noise_n: float = 0.0
+
+    @classmethod
+    def of(cls, params: RigParameters) -> SensorModel:
+        offset = (params.number("sensors.pressure_offset_pa")
+                  if params.has("pressure_sensor_offset") else 0.0)
+        return cls(offset, params.number("sensors.pressure_noise_pa"),
+                   params.number("sensors.speed_noise_rad_s"),
+                   params.number("sensors.force_noise_n"))
+
+    def pressure(self, true_pa: Value, rng: np.random.Generator | None = None) -> Value:
+        """Transducer reading [Pa, gauge] of the true brake pressure."""
+        return _noisy(true_pa + self.pressure_offset_pa, self.pressure_noise_pa, rng)
+
+    def speed(self, true_rad_s: Value, rng: np.random.Generator | None = None) -> Value:
+        """Encoder reading [rad/s]."""
+        return _noisy(true_rad_s, self.speed_noise_rad_s, rng)
+
+    def force(self, true_n: Value, rng: np.random.Generator | None = None) -> Value:
+        """Load-cell reading [N]."""
+        return _noisy(true_n, self.force_noise_n, rng)
+
+    def true_pressure(self, reading_pa: Value) -> Value:
+        """The brake pressure behind a transducer reading (the offset removed) [Pa]."""
+        return reading_pa - self.pressure_offset_pa
+
+
+def _noisy(value: Value, std: float, rng: np.random.Generator | None) -> Value:
+    """``value`` plus N(0, std²) noise of its shape (a new array; a float stays a float)."""
+    if rng is None or std <= 0.0:
+        return value + 0.0
+    size = None if np.ndim(value) == 0 else np.shape(value)
+    return value + rng.normal(0.0, std, size)

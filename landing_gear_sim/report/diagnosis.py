@@ -1,0 +1,160 @@
+"""The diagnosis report: verdict and candidate tables, residual signatures, and per run the
+measured / starting-model / extended-model overlays with their residuals and the residual
+spectrum of the starting model; and the summary printed on the terminal."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from landing_gear_sim.calibration.measured import CHANNELS
+from landing_gear_sim.diagnosis.diagnose import Diagnosis
+from landing_gear_sim.diagnosis.residuals import Spectrum
+from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, HELD_OUT_THRESHOLD
+from landing_gear_sim.report.figures import DISPLAY_UNITS, save_figure
+from landing_gear_sim.report.pages import html_image, html_table, text_table, write_html
+from msg_tools.run import Run
+
+
+def plot_before_after(measured: Run, before: Run, after: Run, channels: Sequence[str],
+                      path: Path) -> Path:
+    """Measured (black), starting model (blue) and extended model (red), and the two
+    residuals, per channel."""
+    fig, axes = plt.subplots(2 * len(channels), 1, figsize=(9, 3.2 * len(channels) + 0.6),
+                             sharex=True, squeeze=False)
+    t = measured.time_s - measured.time_s[0]
+    for i, channel in enumerate(channels):
+        factor, unit = DISPLAY_UNITS[channel]
+        y = getattr(measured, channel)
+        label = CHANNELS[channel].split(" [")[0]
+        top, bottom = axes[2 * i, 0], axes[2 * i + 1, 0]
+        top.plot(t, y * factor, "k", lw=0.6, label="measured")
+        top.plot(t, getattr(before, channel) * factor, "b", lw=0.8, label="starting model")
+        top.plot(t, getattr(after, channel) * factor, "r", lw=0.8, label="extended model")
+        top.set_ylabel(f"{label}\n[{unit}]")
+        bottom.plot(t, (y - getattr(before, channel)) * factor, "b", lw=0.5)
+        bottom.plot(t, (y - getattr(after, channel)) * factor, "r", lw=0.5)
+        bottom.set_ylabel(f"residual\n[{unit}]")
+        for axis in (top, bottom):
+            axis.grid(alpha=0.3)
+    axes[0, 0].legend(loc="upper right", fontsize=8)
+    axes[-1, 0].set_xlabel("time [s]")
+    fig.suptitle(measured.name)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def plot_spectrum(spectrum: Spectrum, title: str, unit: str, path: Path) -> Path:
+    """Residual PSD, its noise floor, the detection threshold and the detected lines."""
+    f = spectrum.frequency_hz
+    band = f > 0
+    fig, axis = plt.subplots(figsize=(8, 3.8))
+    axis.loglog(f[band], spectrum.psd[band], "k", lw=0.7, label="residual PSD")
+    finite = band & np.isfinite(spectrum.floor)
+    axis.loglog(f[finite], spectrum.floor[finite], "g", lw=0.8, label="noise floor")
+    axis.loglog(f[finite], spectrum.floor[finite] * spectrum.threshold, "g--", lw=0.6,
+                label="detection threshold (1 % family-wise)")
+    for peak in spectrum.peaks[:5]:
+        i = int(np.argmin(np.abs(f - peak.frequency_hz)))
+        axis.plot(f[i], spectrum.psd[i], "rv", ms=8)
+        axis.annotate(f"{peak.frequency_hz:.2f} Hz", (f[i], spectrum.psd[i]), fontsize=8,
+                      xytext=(4, 6), textcoords="offset points", color="r")
+    axis.set_xlabel("frequency [Hz]")
+    axis.set_ylabel(f"PSD [{unit}²/Hz]")
+    axis.set_title(title, fontsize=10)
+    axis.grid(alpha=0.3, which="both")
+    axis.legend(fontsize=8)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def write_diagnosis_report(result: Diagnosis, folder: Path) -> Path:
+    """The diagnosis page ``folder/index.html`` with its figures; returns the page."""
+    sections = diagnosis_sections(result, folder)
+    return write_html(folder / "index.html", f"Diagnosis: {result.verdict}", sections)
+
+
+def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]:
+    """HTML sections of the diagnosis page; figures are written into ``folder``. Draws the
+    simulations and spectra the diagnosis kept (``result.evidence``), computes nothing."""
+    def fits(values: dict[str, float]) -> str:
+        return ", ".join(f"{c}: {v:.2f} %" for c, v in values.items())
+
+    findings = html_table(
+        ["cause", "parameters (SI) ± 1σ", "ΔBIC", "held-out Δ", "held-out fit before",
+         "after", "evidence"],
+        [[f.cause, ", ".join(f"{k} = {v:.5g}" + (f" ± {f.std[k]:.2g}" if k in f.std else "")
+                             for k, v in f.parameters.items()),
+          _text(f.delta_bic), _text(f.held_out), fits(f.fit_before), fits(f.fit_after),
+          f.evidence] for f in result.findings])
+    candidates = html_table(
+        ["cause", "accepted", "key parameters", "ΔBIC", "held-out Δ", "fitted on",
+         "checked on"],
+        [[f.cause, "yes" if f.accepted else "no",
+          ", ".join(f"{k} = {v:.4g}" for k, v in f.parameters.items()), _text(f.delta_bic),
+          _text(f.held_out), ", ".join(f.fitted_on), ", ".join(f.checked_on)]
+         for f in result.candidates])
+    verdict = (f"<p><b>Verdict: {result.verdict}</b>. Starting model: "
+               f"{', '.join(result.start.sources)}. ΔBIC = BIC(with) − BIC(without) on the "
+               f"fitting runs (accepted below {BIC_THRESHOLD:g}, and only if the held-out "
+               f"runs improve by more than {-HELD_OUT_THRESHOLD:g} in the same "
+               f"log-likelihood units).</p>")
+    sections = [("Verdict", verdict + findings), ("Candidates", candidates),
+                ("Starting model, calibrated: fit %", html_table(
+                    ["channel", "fit %"], [[c, f"{v:.2f}"] for c, v in result.baseline.items()])),
+                ("Residual structure", html_table(
+                    ["model", "signature"],
+                    [["calibrated starting model", s.describe()] for s in result.signatures_before]
+                    + [["extended model", s.describe()] for s in result.signatures_after]))]
+    for item in result.evidence:
+        run = item.run
+        channels = (("pressure_pa", "wheel_speed_rad_s", "longitudinal_force_n") if run.braking
+                    else ("pressure_pa",))
+        figure = plot_before_after(run, item.before, item.after, channels,
+                                   folder / f"{run.name}.png")
+        body = html_image(figure, folder)
+        if item.spectrum is not None:
+            unit = "Pa" if item.channel == "pressure_pa" else "rad/s"
+            figure = plot_spectrum(item.spectrum, f"{run.name}: {item.channel} residual of the "
+                                   "calibrated starting model", unit,
+                                   folder / f"{run.name}_spectrum.png")
+            body += html_image(figure, folder)
+        sections.append((f"{run.name} ({run.kind})", body))
+    return sections
+
+
+def _text(value: float | None) -> str:
+    return "-" if value is None else f"{value:+.1f}"
+
+
+def diagnosis_summary(result: Diagnosis) -> str:
+    """The terminal summary: candidates, baseline fit, verdict, findings, notes."""
+    rows = [[f.cause, "yes" if f.accepted else "no", _maybe(f.delta_bic),
+             _maybe(f.held_out), f"{_fits(f.fit_before)} -> {_fits(f.fit_after)}"]
+            for f in result.candidates]
+    lines = ["candidates:", text_table(["cause", "accepted", "dBIC", "held-out", "held-out fit %"],
+                                       rows) if rows else "  (none: the model has them all)"]
+    lines.append(f"baseline fit %: {_fits(result.baseline)}")
+    lines.append(f"VERDICT: {result.verdict}")
+    for f in result.findings:
+        values = ", ".join(f"{k} = {v:.6g}" + (f" ± {f.std[k]:.2g}" if k in f.std else "")
+                           for k, v in f.parameters.items())
+        lines.append(f"  {f.cause}: {values}")
+        if f.fit_after and f.fit_after != f.fit_before:
+            gain = ", ".join(f"{c} {f.fit_before[c]:.2f} -> {f.fit_after[c]:.2f} %"
+                             for c in f.fit_after)
+            lines.append(f"    held-out gain: {gain}")
+        lines.append(f"    evidence: {f.evidence}")
+    lines.extend(f"  note: {problem}" for problem in result.problems)
+    return "\n".join(lines)
+
+
+def _fits(values: dict[str, float]) -> str:
+    return ", ".join(f"{c.split('_')[0]} {v:.1f}" for c, v in values.items())
+
+
+def _maybe(value: float | None) -> str:
+    return "-" if value is None else f"{value:+.0f}"

@@ -35,8 +35,11 @@ demo: $(STAMP)
 	$(BIN)/landing-gear-sim campaign out/campaign_delay --seed 7 --set elements.actuator_delay=true --set actuator.delay_s=0.006
 	$(BIN)/landing-gear-sim diagnose out/campaign_delay --json out/diagnosis.json --report out/diagnosis -o out/extended.yaml
 
+# ruff (style), import-linter (the layers: .importlinter), mypy (types: setup.cfg)
 lint: $(STAMP)
 	$(BIN)/ruff check landing_gear_sim antiskid msg_tools test bench launch
+	$(BIN)/lint-imports
+	$(BIN)/mypy
 
 test: lint
 	$(BIN)/python -m pytest -q -n 2 test

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import fields
+from typing import Any
 
 import numpy as np
 
@@ -38,7 +39,7 @@ def settings_type(kind: str) -> type[ThresholdParams] | type[SlipParams]:
     return ThresholdParams if kind == "threshold" else SlipParams
 
 
-def controller_settings(kind: str, values: Mapping[str, object] | None = None,
+def controller_settings(kind: str, values: Mapping[str, Any] | None = None,
                         ) -> ThresholdParams | SlipParams:
     """Validated settings of controller ``kind`` (defaults for keys not given)."""
     kind_type = settings_type(kind)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from rosbags.rosbag2 import Reader, Writer
@@ -24,7 +24,7 @@ from .errors import RunFormatError
 from .run import Run
 
 TYPESTORE = get_typestore(Stores.ROS2_KILTED)
-BAG_VERSION = 9
+BAG_VERSION: Literal[9] = 9
 STORAGE = {"mcap": StoragePlugin.MCAP, "sqlite3": StoragePlugin.SQLITE3}
 
 

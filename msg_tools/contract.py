@@ -1,4 +1,4 @@
-"""The data contract of a measured rig run (docs/design.md, section 4).
+"""The data contract of a measured rig run (docs/data-contract.md).
 
 CSV columns carry the units users read (bar); everything inside is SI (Pa).
 """

@@ -11,7 +11,8 @@ import pytest
 from landing_gear_sim.calibration.campaign import DEVIATING, generate_campaign, rig_like
 from landing_gear_sim.calibration.identify import identify
 from landing_gear_sim.calibration.measured import simulate_run
-from landing_gear_sim.calibration.runs import classify
+from landing_gear_sim.calibration import runs as runs_module
+from landing_gear_sim.calibration.runs import RunKind, classify
 from landing_gear_sim.calibration.validate import fit_percent, validate
 from landing_gear_sim.cli import main
 from landing_gear_sim.model.parameters import load_parameters
@@ -100,6 +101,8 @@ def test_identify_cli_writes_params_and_evidence(campaign_dir, tmp_path, capsys,
                  "--report", str(tmp_path / "report")]) == 0
     page = (tmp_path / "report" / "index.html").read_text()
     assert "brake_osc_low.png" in page and "friction.png" in page
+    assert "actuator_steps_sweep_frf.png" in page  # the actuator's FRF against the model's
+    assert (tmp_path / "report" / "actuator_steps_sweep_frf.png").stat().st_size > 10_000
     capsys.readouterr()
 
 
@@ -118,7 +121,7 @@ def test_failed_identify_overwrites_nothing(tmp_path, capsys):
 def test_classify_tells_actuator_only_from_braking(campaign_dir):
     runs = {r.name: r for r in read_campaign(campaign_dir).runs}
     assert classify(runs["actuator_ramp"]).startswith("actuator")
-    assert classify(runs["brake_const_30bar"]) == "brake_constant"
+    assert classify(runs["brake_const_30bar"]) is RunKind.BRAKE_CONSTANT
 
 
 def test_generated_campaign_is_reproducible(tmp_path, reference):
@@ -154,3 +157,25 @@ def test_a_model_that_stops_early_still_follows_the_valve_pressure(campaign_dir,
     assert np.all(held == held[0])
     tail = slice(stopped, None)
     assert fit_percent(run.pressure_pa[tail], simulated.pressure_pa[tail]) > 90.0
+
+
+def test_identify_classifies_each_run_once(campaign_dir, reference, monkeypatch):
+    """The kind travels with the run: the output-error fits (hundreds of simulations) never
+    classify again."""
+    calls = []
+    real = runs_module.classify
+    monkeypatch.setattr(runs_module, "classify", lambda run: calls.append(run.name) or real(run))
+    runs = read_campaign(campaign_dir).runs
+    identify(runs, reference, jackknife=False)
+    assert sorted(calls) == sorted(r.name for r in runs)
+
+
+def test_simulating_a_measured_run_never_adds_noise(campaign_dir, reference):
+    """A params file that carries sensor noise (a generator's) still compares noise-free."""
+    run = next(r for r in read_campaign(campaign_dir).runs if r.name == "brake_const_30bar")
+    noisy = reference.replace({"sensors.pressure_noise_pa": 2e4,
+                               "sensors.speed_noise_rad_s": 0.1}, "test")
+    first, second = simulate_run(run, noisy)[0], simulate_run(run, noisy)[0]
+    clean = simulate_run(run, reference)[0]
+    assert np.array_equal(first.pressure_pa, second.pressure_pa)
+    assert np.array_equal(first.wheel_speed_rad_s, clean.wheel_speed_rad_s)

@@ -164,8 +164,8 @@ def fit_brake_gain(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
     names = tuple(b.run.name for b in runs)
     if not p.has("brake_fade"):
         gain = float(pr @ t / (pr @ pr))
-        std = float(linear_std(pr[:, None], t - gain * pr, 1)[0])
-        return [Estimate("brake.gain_n_m_per_pa", gain, std, names, "wheel torque balance")]
+        gain_std = float(linear_std(pr[:, None], t - gain * pr, 1)[0])
+        return [Estimate("brake.gain_n_m_per_pa", gain, gain_std, names, "wheel torque balance")]
     keys = ("brake.gain_n_m_per_pa", "brake.fade_fraction", "brake.fade_energy_j")
 
     def residual(theta: np.ndarray) -> np.ndarray:
@@ -177,9 +177,9 @@ def fit_brake_gain(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
     fit = least_squares(residual, start, bounds=([1e-3, 0.0, math.log(1e3)],
                                                  [1e2, 0.95, math.log(1e9)]))
     std = covariance_std(fit, 3)
-    gain, fraction, log_energy = fit.x
+    k_b, fraction, log_energy = fit.x
     method = "wheel torque balance with fade"
-    return [Estimate(keys[0], gain * GAIN_UNIT, std[0] * GAIN_UNIT, names, method),
+    return [Estimate(keys[0], k_b * GAIN_UNIT, std[0] * GAIN_UNIT, names, method),
             Estimate(keys[1], fraction, std[1], names, method),
             Estimate(keys[2], math.exp(log_energy), math.exp(log_energy) * std[2], names,
                      method)]

@@ -8,7 +8,7 @@ tests and benchmarks; identification and diagnosis never read that file.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +17,7 @@ from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.csv_io import write_csv
+from msg_tools.units import PA_PER_BAR
 
 DEVIATING = ("flywheel.inertia_kg_m2", "drag.coeff_n_s2_per_m2", "friction.theta1",
              "friction.theta2", "friction.theta3", "brake.gain_n_m_per_pa",
@@ -39,18 +40,17 @@ def rig_like(datasheet: RigParameters, rng: np.random.Generator,
 
 def standard_scenarios(p: RigParameters) -> dict[str, sc.Scenario]:
     """The runs of a calibration campaign (same names as the example campaigns)."""
-    runs: dict[str, Callable[[], sc.Scenario]] = {
-        "actuator_ramp": lambda: sc.actuator_test(
-            p, sc.quasi_static_ramp(p.number("actuator.max_current_a")), 20.0, "actuator_ramp"),
-        "actuator_steps_sweep": lambda: sc.actuator_test(
-            p, sc.steps_then_sweep(), 28.0, "actuator_steps_sweep"),
-        **{f"brake_const_{bar}bar": (lambda bar=bar: sc.constant_pressure_test(p, bar * 1e5))
+    max_current = p.number("actuator.max_current_a")
+    return {
+        "actuator_ramp": sc.actuator_test(p, sc.quasi_static_ramp(max_current), 20.0,
+                                          "actuator_ramp"),
+        "actuator_steps_sweep": sc.actuator_test(p, sc.steps_then_sweep(), 28.0,
+                                                 "actuator_steps_sweep"),
+        **{f"brake_const_{bar}bar": sc.constant_pressure_test(p, bar * PA_PER_BAR)
            for bar in (10, 20, 30, 40)},
-        "brake_osc_low": lambda: sc.rig_test(p, sc.oscillating(**sc.OSC_LOW), "brake_osc_low"),
-        "brake_osc_high": lambda: sc.rig_test(p, sc.oscillating(**sc.OSC_HIGH),
-                                              "brake_osc_high"),
+        "brake_osc_low": sc.rig_test(p, sc.oscillating(**sc.OSC_LOW), "brake_osc_low"),
+        "brake_osc_high": sc.rig_test(p, sc.oscillating(**sc.OSC_HIGH), "brake_osc_high"),
     }
-    return {name: build() for name, build in runs.items()}
 
 
 def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,

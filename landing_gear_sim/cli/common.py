@@ -75,7 +75,7 @@ def mapping_of(args: argparse.Namespace) -> Mapping | None:
     return read_mapping(args.mapping) if getattr(args, "mapping", None) else None
 
 
-def write_atomically(path: Path, write: Callable[[Path], None]) -> None:
+def write_atomically(path: Path, write: Callable[[Path], object]) -> None:
     """Write via a temporary file so a failure never leaves a half-written ``path``."""
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".part")

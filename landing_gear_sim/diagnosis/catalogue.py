@@ -197,7 +197,8 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
     """
     chosen = select(classify_all(runs), candidate.runs)
     if not chosen:
-        raise IdentificationError(f"{candidate.cause}: no {'/'.join(candidate.runs)} run to fit on")
+        kinds = "/".join(str(k) for k in candidate.runs)
+        raise IdentificationError(f"{candidate.cause}: no {kinds} run to fit on")
     scales = scales or noise_scales(chosen, candidate.channels)
     own = () if null else candidate.keys
     model = base if null else switched_on(candidate, base)
@@ -205,8 +206,8 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
     references = [base] + ([datasheet] if datasheet is not None else [])
     keys = [*own, *free]
     if not keys:
-        residual = scaled_residual(chosen, model, candidate.channels, scales)
-        return CandidateFit(candidate, model, {}, {}, residual)
+        error = scaled_residual(chosen, model, candidate.channels, scales)
+        return CandidateFit(candidate, model, {}, {}, error)
     own_bounds = candidate.bounds if own else ()
     lower = np.array([b[0] for b in own_bounds]
                      + [0.5 * min(r.number(k) for r in references) for k in free])

@@ -4,10 +4,10 @@ The laws with explicit coefficients (:func:`burckhardt_mu`, :func:`slip_ratio`,
 :func:`valve_map`, :func:`fade_factor`) take floats or numpy arrays alike — the same
 compiled definition serves the plant's scalar loop and the array code of calibration,
 metrics and plots. They are inlined into their callers (``inline="always"``): as separate
-calls they made the plant's RK4 loop 24 % slower. The others take the packed parameter vector ``p`` (see
-:mod:`landing_gear_sim.model.parameters`) and SI quantities, and are pure. The plant
-(:mod:`landing_gear_sim.model.plant`) composes them; a switchable element is skipped
-when its ``elements.<name>`` flag is 0. Equation numbers refer to the paper.
+calls they made the plant's RK4 loop 24 % slower. The others take the packed parameter
+vector ``p`` (see :mod:`landing_gear_sim.model.parameters`) and SI quantities, and are
+pure. The plant (:mod:`landing_gear_sim.model.plant`) composes them; a switchable element
+is skipped when its ``elements.<name>`` flag is 0. Equation numbers refer to the paper.
 :mod:`landing_gear_sim.model.quantities` evaluates them on arrays for a parameter set.
 """
 

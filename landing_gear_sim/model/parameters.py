@@ -165,7 +165,7 @@ class RigParameters:
 
     def number(self, key: str) -> float:
         """A numeric parameter as float."""
-        return float(self.values[key])  # type: ignore[arg-type]
+        return float(self.values[key])
 
     def has(self, element: str) -> bool:
         """Whether a switchable element is on."""
@@ -197,7 +197,7 @@ class RigParameters:
             if spec.kind == "choice":
                 out[INDEX[spec.key]] = spec.choices.index(str(value))
             else:
-                out[INDEX[spec.key]] = float(value)  # type: ignore[arg-type]
+                out[INDEX[spec.key]] = float(value)
         return out
 
     def to_yaml(self, path: Path, node: str = "/**") -> None:
@@ -209,7 +209,7 @@ class RigParameters:
             for part in parents:
                 section = section.setdefault(part, {})
             value = self.values[spec.key]
-            section[leaf] = float(value) if spec.kind == "float" else value  # type: ignore[arg-type]
+            section[leaf] = float(value) if spec.kind == "float" else value
         text = yaml.safe_dump({node: {"ros__parameters": nested}}, sort_keys=False)
         Path(path).write_text(text)
 

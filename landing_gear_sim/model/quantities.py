@@ -7,11 +7,15 @@ restates it. Inputs and outputs are numpy arrays of the same shape, SI.
 from __future__ import annotations
 
 import math
+from typing import TypeVar
 
 import numpy as np
 
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model.parameters import RigParameters
+
+Value = TypeVar("Value", float, np.ndarray)
+"""A float or an array: the same law serves a node's one sample and a run's arrays."""
 
 PEAK_GRID = np.linspace(0.0, 1.0, 20001)  # slip grid on which the friction peak is sought
 
@@ -41,12 +45,12 @@ def peak_friction(params: RigParameters) -> tuple[float, float]:
     return float(mu[best]), float(PEAK_GRID[best])
 
 
-def rim_speed_m_s(params: RigParameters, flywheel_speed_rad_s: np.ndarray) -> np.ndarray:
+def rim_speed_m_s(params: RigParameters, flywheel_speed_rad_s: Value) -> Value:
     """Flywheel rim (vehicle) speed ω_f R_f [m/s] from the flywheel encoder [rad/s]."""
     return flywheel_speed_rad_s * params.number("flywheel.radius_m")
 
 
-def flywheel_speed_rad_s(params: RigParameters, rim_speed: np.ndarray) -> np.ndarray:
+def flywheel_speed_rad_s(params: RigParameters, rim_speed: Value) -> Value:
     """Flywheel encoder speed [rad/s] of a rim speed [m/s] (inverse of rim_speed_m_s)."""
     return rim_speed / params.number("flywheel.radius_m")
 

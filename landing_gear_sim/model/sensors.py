@@ -10,13 +10,12 @@ is never noisy by accident. Values are floats or arrays alike.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TypeVar
+from typing import Any
 
 import numpy as np
 
 from landing_gear_sim.model.parameters import RigParameters
-
-Value = TypeVar("Value", float, np.ndarray)
+from landing_gear_sim.model.quantities import Value
 
 
 @dataclass(frozen=True)
@@ -58,4 +57,5 @@ def _noisy(value: Value, std: float, rng: np.random.Generator | None) -> Value:
     if rng is None or std <= 0.0:
         return value + 0.0
     size = None if np.ndim(value) == 0 else np.shape(value)
-    return value + rng.normal(0.0, std, size)
+    noise: Any = rng.normal(0.0, std, size)  # a float when size is None
+    return value + noise

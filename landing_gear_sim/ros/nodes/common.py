@@ -236,6 +236,7 @@ def spin(node: Node) -> None:
     Services are not served (the nodes run without parameter services by default).
     """
     context = node.context
+    assert context.handle is not None, "spin() needs an initialised context"
     shutdown = SignalHandlerGuardCondition(context)
     try:
         while context.ok():
@@ -275,7 +276,7 @@ def _take_all(subscriptions: list[Subscription], ready: list[int]) -> None:
                                                          subscription.raw)
             if taken is None:
                 break
-            subscription.callback(taken[0])
+            subscription.callback(taken[0])  # type: ignore[call-arg]  # message-only callbacks
 
 
 def run_node(factory: Callable[[], Node], args: list[str] | None = None) -> int:

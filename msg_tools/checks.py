@@ -5,10 +5,11 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import RunFormatError
+from .units import PA_PER_BAR
 
 PLAUSIBLE_MAX: dict[str, tuple[float, str, float]] = {
     "current_a": (20.0, "A", 1.0),
-    "pressure_pa": (500e5, "bar", 1e5),
+    "pressure_pa": (500 * PA_PER_BAR, "bar", PA_PER_BAR),
     "wheel_speed_rad_s": (5000.0, "rad/s", 1.0),
     "flywheel_speed_rad_s": (2000.0, "rad/s", 1.0),
     "vertical_load_n": (2e6, "N", 1.0),

@@ -8,10 +8,10 @@ import shutil
 import numpy as np
 import pytest
 
+from landing_gear_sim.calibration import runs as runs_module
 from landing_gear_sim.calibration.campaign import DEVIATING, generate_campaign, rig_like
 from landing_gear_sim.calibration.identify import identify
 from landing_gear_sim.calibration.measured import simulate_run
-from landing_gear_sim.calibration import runs as runs_module
 from landing_gear_sim.calibration.runs import RunKind, classify
 from landing_gear_sim.calibration.validate import fit_percent, validate
 from landing_gear_sim.cli import main

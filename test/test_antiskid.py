@@ -19,6 +19,7 @@ from antiskid.metrics import braking_metrics, peak_friction
 from landing_gear_sim.cli import main
 from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
+from landing_gear_sim.model.parameters import load_parameters
 
 SURFACES = ("dry", "wet", "snow")
 
@@ -116,8 +117,7 @@ def test_antiskid_and_metrics_commands(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "slip_snow" in out and "constant" in out and (tmp_path / "slip.png").is_file()
     config = tmp_path / "snow.yaml"
-    with_surface(__import__("landing_gear_sim.model.parameters").parameters.load_parameters(),
-                 "snow").to_yaml(config)
+    with_surface(load_parameters(), "snow").to_yaml(config)
     assert main(["metrics", str(csv), "--config", str(config), "--json",
                  str(tmp_path / "m.json"), "--plot", str(tmp_path / "m.png")]) == 0
     written = json.loads((tmp_path / "m.json").read_text())

@@ -11,15 +11,14 @@ from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
 from landing_gear_sim.ros.graph import LAUNCH_ARGUMENTS, PACKAGE, describe, options_from_arguments
-from landing_gear_sim.ros.launcher import ros_environment
 
 
 def _nodes(context):
     values = {name: LaunchConfiguration(name).perform(context) for name in LAUNCH_ARGUMENTS}
     options, params_file = options_from_arguments(values)
-    env = ros_environment({})  # DDS on this machine, a private domain unless the user set one
+    # the user's ROS_DOMAIN_ID and discovery settings reach the nodes untouched
     return [Node(package=PACKAGE, executable=node.name, name=node.name, output="screen",
-                 parameters=[str(params_file), node.parameters], additional_env=env)
+                 parameters=[str(params_file), node.parameters])
             for node in describe(options)]
 
 

@@ -202,7 +202,9 @@ def _with_links(nodes: list[NodeSpec]) -> list[NodeSpec]:
     linked = []
     for node in nodes:
         expected = [f"{topic}={readers[topic]}" for topic in node.publishes if readers[topic]]
-        extra: dict[str, ParamValue] = {"expected_subscribers": expected}
+        # an empty list has no type in a ROS parameter (launch_ros refuses it): leave the
+        # node's default, which expects no reader, instead
+        extra: dict[str, ParamValue] = {"expected_subscribers": expected} if expected else {}
         if node.name == "plant":
             extra["peers"] = [n.name for n in nodes if n.name != "plant"]
         linked.append(NodeSpec(node.name, {**node.parameters, **extra}, node.publishes,

@@ -27,11 +27,13 @@ PR_SET_PDEATHSIG = 1
 
 
 def ros_environment(environ: dict[str, str] | None = None) -> dict[str, str]:
-    """The environment for the nodes: DDS on this machine, a private domain unless chosen."""
+    """The environment for the nodes: the user's own (``environ``, default the process's).
+
+    The domain and discovery settings are the user's: the launcher never picks them (the
+    tests and ``make`` choose a private domain on this machine for themselves).
+    """
     env = dict(os.environ if environ is None else environ)
-    env.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
-    env.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
-    env.setdefault("PYTHONUNBUFFERED", "1")
+    env.setdefault("PYTHONUNBUFFERED", "1")  # node logs arrive as they are written
     return env
 
 
@@ -79,8 +81,10 @@ def _run_processes(options: GraphOptions, params_file: Path,
                    say: Callable[[str], None]) -> Outcome:
     env = ros_environment()
     nodes = describe(options)
-    say(f"starting {', '.join(n.name for n in nodes)} (ROS_DOMAIN_ID={env['ROS_DOMAIN_ID']}, "
-        f"discovery {env['ROS_AUTOMATIC_DISCOVERY_RANGE']})")
+    domain = env.get("ROS_DOMAIN_ID", "unset: 0")
+    discovery = env.get("ROS_AUTOMATIC_DISCOVERY_RANGE", "unset: SUBNET")
+    say(f"starting {', '.join(n.name for n in nodes)} (ROS_DOMAIN_ID {domain}, discovery "
+        f"{discovery})")
     processes = {n.name: subprocess.Popen(node_command(n, params_file), env=env,
                                           preexec_fn=_die_with_parent) for n in nodes}
     interrupted = False

@@ -11,8 +11,10 @@ its unit::
     vertical_load_N: {column: Fz, unit: kN}
     longitudinal_force_N: {column: Fx, unit: kN}
 
-Values are written with 12 significant digits: far below any sensor's resolution,
-and enough margin that CSV -> bag -> CSV gives back the same text.
+Values are written with 12 significant digits (far below any sensor's resolution), time
+with 1 µs resolution whatever its origin: a recording stamped with epoch time (~1.7e9 s)
+keeps its microseconds, which 12 significant digits would round to 10 ms. CSV -> bag ->
+CSV gives back the same text.
 """
 
 from __future__ import annotations
@@ -28,6 +30,9 @@ from .contract import CSV_COLUMNS, CSV_SCALE_TO_SI, CSV_TO_FIELD
 from .errors import RunFormatError
 from .run import Run
 from .units import QUANTITY, UNITS
+
+TIME_FORMAT = ".6f"  # 1 µs, absolute epoch times included (float64 resolves 0.24 µs there)
+VALUE_FORMAT = ".12g"
 
 Mapping = dict[str, tuple[str, float]]
 """Contract column → (file column, factor to SI)."""
@@ -101,8 +106,10 @@ def format_csv(run: Run) -> str:
     table = np.column_stack(
         [getattr(run, CSV_TO_FIELD[c]) / CSV_SCALE_TO_SI[c] for c in CSV_COLUMNS]
     )
+    formats = [TIME_FORMAT if c == "time_s" else VALUE_FORMAT for c in CSV_COLUMNS]
     lines = [",".join(CSV_COLUMNS)]
-    lines.extend(",".join(format(value, ".12g") for value in row) for row in table.tolist())
+    lines.extend(",".join(format(value, f) for value, f in zip(row, formats, strict=True))
+                 for row in table.tolist())
     return "\n".join(lines) + "\n"
 
 

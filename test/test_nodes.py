@@ -245,3 +245,19 @@ def test_controller_node_in_lockstep_equals_the_offline_closed_loop(tmp_path, ki
     for field in FIELDS:
         np.testing.assert_allclose(getattr(graph, field), getattr(offline, field), rtol=1e-9,
                                    atol=1e-6, err_msg=field)
+
+
+@pytest.mark.parametrize("node", ["plant", "actuator", "recorder"])
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_a_signal_to_a_lone_node_ends_it_cleanly(tmp_path, start, node, sig):
+    """`ros2 run landing_gear_sim plant` then Ctrl-C (or a TERM): exit 0, no traceback."""
+    extra = ["-p", f"bag:={tmp_path / 'bag'}"] if node == "recorder" else []
+    process = start([sys.executable, "-m", f"landing_gear_sim.ros.nodes.{node}", "--ros-args",
+                     *extra])
+    deadline = time.monotonic() + 60
+    while "running" not in (line := process.stderr.readline()) and time.monotonic() < deadline:
+        assert process.poll() is None, line
+    process.send_signal(sig)
+    _, errors = process.communicate(timeout=30)
+    assert process.returncode == 0, errors[-2000:]
+    assert "Traceback" not in errors

@@ -12,7 +12,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from landing_gear_sim.calibration.actuator import FrfEstimate
+from landing_gear_sim.calibration.actuator import MIN_COHERENCE, FrfEstimate
 from landing_gear_sim.calibration.measured import CHANNELS
 from landing_gear_sim.calibration.statistics import Estimate
 from landing_gear_sim.calibration.validate import RunComparison, Validation
@@ -63,18 +63,26 @@ def plot_friction(slip: np.ndarray, mu: np.ndarray, params: RigParameters, path:
 
 
 def plot_frf(frf: FrfEstimate, path: Path) -> Path:
-    """Measured actuator FRF (H1) with its coherence, and the model's A(s) beside it."""
+    """Measured actuator FRF (H1) with its coherence, and the model's A(s) beside it. Bins
+    where the coherence is low (the valve no longer follows the sweep) are drawn faint,
+    and the measured phase only where it is meaningful."""
     band = (frf.frequency_hz > 0.3) & (frf.frequency_hz < 150)
     f = frf.frequency_hz[band]
+    coherent = frf.coherence[band] >= MIN_COHERENCE
+    gain_db = 20 * np.log10(np.abs(frf.response[band]))
+    phase = np.degrees(np.unwrap(np.angle(frf.response[band])))
     fig, axes = plt.subplots(3, 1, figsize=(7, 7), sharex=True)
-    axes[0].semilogx(f, 20 * np.log10(np.abs(frf.response[band])), "k.", ms=3, label="H1")
+    axes[0].semilogx(f[coherent], gain_db[coherent], "k.", ms=3, label="H1 (measured)")
+    axes[0].semilogx(f[~coherent], gain_db[~coherent], ".", color="0.8", ms=2,
+                     label=f"H1, coherence < {MIN_COHERENCE:g}")
     axes[0].semilogx(f, 20 * np.log10(np.abs(frf.model[band])), "r", label="model A(s)")
     axes[0].set_ylabel("magnitude [dB]")
-    axes[0].legend()
-    axes[1].semilogx(f, np.degrees(np.unwrap(np.angle(frf.response[band]))), "k.", ms=3)
+    axes[0].legend(fontsize=8)
+    axes[1].semilogx(f[coherent], phase[coherent], "k.", ms=3)
     axes[1].semilogx(f, np.degrees(np.unwrap(np.angle(frf.model[band]))), "r")
     axes[1].set_ylabel("phase [deg]")
     axes[2].semilogx(f, frf.coherence[band], "b")
+    axes[2].axhline(MIN_COHERENCE, color="0.6", ls="--", lw=0.8)
     axes[2].set_ylabel("coherence")
     axes[2].set_xlabel("frequency [Hz]")
     for axis in axes:

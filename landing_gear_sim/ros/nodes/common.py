@@ -285,6 +285,7 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None) -> int:
     node = None
     try:
         node = factory()
+        node.get_logger().info("running (SIGINT or SIGTERM stops it)")
         spin(node)
     except (RunFinishedError, KeyboardInterrupt, ExternalShutdownException):
         pass

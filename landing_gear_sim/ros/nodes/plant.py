@@ -227,6 +227,8 @@ class PlantNode(GraphNode):
             self.get_logger().warning("still waiting: " + "; ".join(missing))
 
     def close(self) -> None:
+        if not self.context.ok():  # stopped by a signal: the context is gone, nothing to flush
+            return
         for publisher in (*self._out.values(), self._end):
             publisher.wait_for_all_acked()  # nothing published is lost when the plant leaves
 

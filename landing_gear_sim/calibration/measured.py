@@ -17,7 +17,6 @@ from landing_gear_sim.model.integrate import SimulationResult, simulate
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s
 from landing_gear_sim.model.scenario import Scenario, logged_to_held
-from msg_tools.io import is_uniform, resample
 from msg_tools.run import Run
 
 CHANNELS: dict[str, str] = {
@@ -39,21 +38,19 @@ def channels_of(run: ClassifiedRun) -> tuple[str, ...]:
     return tuple(CHANNELS) if run.braking else ACTUATOR_CHANNELS
 
 
-def scenario_for_run(run: ClassifiedRun, params: RigParameters,
-                     timing: Run | None = None) -> Scenario:
-    """The measured run's input as a scenario: its current, its initial speed, its timing
-    (``timing``: the same run on another time base, e.g. resampled)."""
-    base = timing or run
-    initial = float(np.mean(rim_speed_m_s(params, base.flywheel_speed_rad_s[
+def scenario_for_run(run: ClassifiedRun, params: RigParameters) -> Scenario:
+    """The measured run's input as a scenario: its current, its initial speed, its timing."""
+    initial = float(np.mean(rim_speed_m_s(params, run.flywheel_speed_rad_s[
         :INITIAL_SPEED_SAMPLES])))
     contact = run.braking
-    return Scenario(run.name, logged_to_held(base.current_a), base.rate_hz, contact,
+    return Scenario(run.name, logged_to_held(run.current_a), run.rate_hz, contact,
                     initial if contact else 0.0, LOWEST_SIM_SPEED_M_S if contact else 0.0,
                     "measured input")
 
 
 def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult]:
-    """Simulate ``run`` with its measured current; the result on the run's time base.
+    """Simulate ``run`` with its measured current; the result on the run's (uniform, see
+    :func:`~landing_gear_sim.calibration.runs.classified`) time base.
 
     If the model stops (speed below 1 m/s) before the measurement ends, the last
     simulated sample is held, so both have the same length, except the pressure: the
@@ -61,16 +58,15 @@ def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult
     start, as in the rig procedure.
     """
     run = classified(run)
-    uniform = run if is_uniform(run, 1e-3) else resample(run, round(run.rate_hz))
-    result = simulate(params, scenario_for_run(run, params, uniform))
+    result = simulate(params, scenario_for_run(run, params))
     simulated = result.to_run()
-    n, m = len(uniform), len(simulated)
+    n, m = len(run), len(simulated)
     take = np.minimum(np.arange(n), m - 1)
     fields = {name: getattr(simulated, name)[take] for name in CHANNELS}
     if m < n:
         fields["pressure_pa"] = result.sensed_pressure_to_end()[:n]
-    return Run(name=run.name, source="simulation", time_s=uniform.time_s,
-               current_a=uniform.current_a, **fields), result
+    return Run(name=run.name, source="simulation", time_s=run.time_s,
+               current_a=run.current_a, **fields), result
 
 
 def simulate_all(runs: Sequence[Run], params: RigParameters) -> list[Run]:

@@ -1,8 +1,11 @@
 """Measured runs and their kinds: each run classified once, from its signals, and carried.
 
-A :class:`ClassifiedRun` is a :class:`~msg_tools.run.Run` that knows its
-:class:`RunKind` and its braking start; identification, validation and diagnosis
-classify the runs they are given once (:func:`classified`) and pass these on.
+A :class:`ClassifiedRun` is a :class:`~msg_tools.run.Run` on a uniform time base that
+knows its :class:`RunKind` and its braking start; identification, validation and
+diagnosis classify the runs they are given once (:func:`classified`) and pass these on.
+A run whose samples are not evenly spaced (timestamp jitter, a logger's float steps) is
+put on the uniform grid of its mean rate first (linear interpolation, the current held):
+every filter, derivative and simulation downstream assumes one sample period.
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ import numpy as np
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s
 from landing_gear_sim.model.scenario import brake_start_index
+from msg_tools.io import is_uniform, resample
 from msg_tools.run import Run
 
 STILL_FLYWHEEL_RAD_S = 1.0  # an actuator-only run: the flywheel stands still ...
@@ -25,6 +29,7 @@ RAMP_STEP_A = 2e-3  # largest current change per sample of a quasi-static ramp
 RAMP_SPAN_A = 0.5  # ... which must cover this much of the valve's range
 CONSTANT_STD_A = 5e-3  # a braking run whose current varies less than this is constant
 SETTLE_S = 0.3  # after the braking start the current has settled
+UNIFORM_TOLERANCE = 1e-3  # of a period: steps closer than this count as evenly spaced
 
 
 class Family(enum.Enum):
@@ -81,12 +86,20 @@ class ClassifiedRun(Run):
 
     @classmethod
     def of(cls, run: Run) -> ClassifiedRun:
+        """``run`` on a uniform time base, classified."""
+        run = on_uniform_grid(run)
         fields = {f.name: getattr(run, f.name) for f in dataclasses.fields(Run)}
         return cls(**fields, kind=classify(run), brake_start_s=brake_start_s(run))
 
     @property
     def braking(self) -> bool:
         return self.kind.braking
+
+
+def on_uniform_grid(run: Run) -> Run:
+    """``run`` itself if its samples are evenly spaced (to 0.1 % of a period), else
+    resampled at its mean rate rounded to 1 Hz."""
+    return run if is_uniform(run, UNIFORM_TOLERANCE) else resample(run, round(run.rate_hz))
 
 
 def classified(run: Run) -> ClassifiedRun:

@@ -109,3 +109,16 @@ def test_console_script_is_installed():
     result = subprocess.run([str(script), "--version"], capture_output=True, text=True,
                             env=os.environ, check=False)
     assert result.returncode == 0 and "landing-gear-sim" in result.stdout
+
+
+def test_an_unwritable_output_is_refused_before_the_work(tmp_path, capsys):
+    """Once a traceback after 36 s of diagnosis, and the extended model lost."""
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    code = main(["diagnose", str(tmp_path), "--report", str(blocker / "report"),
+                 "-o", str(tmp_path / "extended.yaml")])
+    err = capsys.readouterr().err
+    assert code == 2 and "cannot write there" in err and "calibrating" not in err
+    assert len(err.strip().splitlines()) == 1
+    assert main(["identify", str(tmp_path), "-o", str(tmp_path)]) == 2  # a folder, not a file
+    assert "is a folder" in capsys.readouterr().err

@@ -66,8 +66,8 @@ def test_sensor_noise_follows_the_configured_std(reference):
 @pytest.mark.parametrize(("mutate", "fragment"), [
     (lambda lines: [lines[0].replace("brake_pressure_bar", "pressure"), *lines[1:]],
      "missing column"),
-    (lambda lines: [lines[0], lines[1].replace(lines[1].split(",")[2], "nan", 1), *lines[2:]],
-     "NaN"),
+    (lambda lines: [lines[0], ",".join([*lines[1].split(",")[:2], "nan",
+                                        *lines[1].split(",")[3:]]), *lines[2:]], "NaN"),
     (lambda lines: [lines[0], lines[2], lines[1], *lines[3:]], "not strictly increasing"),
     (lambda lines: [lines[0], "a,b,c,d,e,f,g", *lines[2:]], "unreadable values"),
 ])

@@ -189,8 +189,7 @@ def _bad_files(folder: Path) -> dict[str, tuple[Path, str]]:
         "empty": ("", "the file is empty"),
         "header_only": (header + "\n", "expected >= 2 rows"),
         "no_column": (good.replace("brake_pressure_bar", "pressure"), "missing column"),
-        "nan": ("\n".join([header, rows[0].replace(rows[0].split(",")[2], "nan", 1), *rows[1:]]),
-                "NaN"),
+        "nan": ("\n".join([header, _with_field(rows[0], 2, "nan"), *rows[1:]]), "NaN"),
         "time_back": ("\n".join([header, rows[1], rows[0], *rows[2:]]), "not strictly increasing"),
         "garbage": ("\x00\x01binary", "missing column"),
     }
@@ -201,6 +200,12 @@ def _bad_files(folder: Path) -> dict[str, tuple[Path, str]]:
             path.write_text(text)
         files[name] = (path, fragment)
     return files
+
+
+def _with_field(row: str, index: int, value: str) -> str:
+    fields = row.split(",")
+    fields[index] = value
+    return ",".join(fields)
 
 
 def test_replay_of_a_bad_file_is_one_error_line_and_exit_2(tmp_path):

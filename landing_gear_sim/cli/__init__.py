@@ -53,6 +53,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except LandingGearSimError as exc:
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:  # a disk full or a folder gone while writing: still one line
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return 130

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 from landing_gear_sim.cli.common import (
     add_params_arguments,
+    check_outputs,
     mapping_of,
     params_of,
     progress,
@@ -93,6 +94,8 @@ def cmd_identify(args: argparse.Namespace) -> int:
     from landing_gear_sim.report.validation import estimates_table
     from msg_tools.io import read_campaign
 
+    check_outputs(files=[args.output])
+
     campaign = read_campaign(args.campaign, mapping_of(args))
     for problem in campaign.problems:
         progress(f"skipped: {problem}")
@@ -126,6 +129,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     )
     from msg_tools.io import read_campaign
 
+    check_outputs(folders=[args.report])
     campaign = read_campaign(args.campaign, mapping_of(args))
     params = params_of(args)
     progress(f"simulating {len(campaign.runs)} runs with their measured inputs")
@@ -142,6 +146,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     from landing_gear_sim.report.validation import plot_overlay
     from msg_tools.io import read_run
 
+    check_outputs(files=[args.plot])
     measured, simulated = read_run(args.measured, mapping_of(args)), read_run(args.simulated)
     comparison = compare(measured, simulated)
     rows = [[channel, f"{s.fit_percent:.2f}", f"{s.rmse:.4g}", f"{s.max_error:.4g}"]
@@ -157,6 +162,8 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     from landing_gear_sim.diagnosis.diagnose import diagnose
     from landing_gear_sim.report.diagnosis import diagnosis_summary, write_diagnosis_report
     from msg_tools.io import read_runs
+
+    check_outputs(files=[args.json, args.output], folders=[args.report])
 
     campaign = read_runs(args.runs, mapping_of(args))
     for problem in campaign.problems:
@@ -186,6 +193,7 @@ def cmd_metrics(args: argparse.Namespace) -> int:
     from landing_gear_sim.report.braking import metrics_table
     from msg_tools.io import read_run
 
+    check_outputs(files=[args.json, args.plot])
     rig = params_of(args)
     run = read_run(args.run, mapping_of(args))
     metrics = braking_metrics(run, rig)
@@ -205,6 +213,7 @@ def cmd_antiskid(args: argparse.Namespace) -> int:
     from landing_gear_sim.report.braking import metrics_table
     from msg_tools.csv_io import write_csv
 
+    check_outputs(files=[args.output, args.json, args.plot])
     rig = with_surface(params_of(args), args.surface)
     settings = dict(parse_assignment(text) for text in args.setting)
     step_s = 1.0 / (args.rate or rig.number("simulation.output_rate_hz"))

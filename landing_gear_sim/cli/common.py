@@ -5,9 +5,11 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from collections.abc import Callable
+import tempfile
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from landing_gear_sim.errors import LandingGearSimError
 from landing_gear_sim.model.parameters import (
     ELEMENTS,
     RigParameters,
@@ -73,6 +75,24 @@ def mapping_of(args: argparse.Namespace) -> Mapping | None:
     from msg_tools.csv_io import read_mapping
 
     return read_mapping(args.mapping) if getattr(args, "mapping", None) else None
+
+
+def check_outputs(files: Sequence[Path | None] = (), folders: Sequence[Path | None] = ()
+                  ) -> None:
+    """Fail before the work, with one error line, when an output cannot be written: its
+    folder cannot be made or written to, or a file's path is a folder."""
+    for path in files:
+        if path is not None and path.is_dir():
+            raise LandingGearSimError(f"{path}: is a folder, expected a file name")
+    targets = [f.parent for f in files if f is not None] + [d for d in folders if d is not None]
+    for folder in targets:
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+            with tempfile.TemporaryFile(dir=folder):
+                pass
+        except OSError as exc:
+            raise LandingGearSimError(f"{folder}: cannot write there "
+                                      f"({exc.strerror or exc})") from None
 
 
 def write_atomically(path: Path, write: Callable[[Path], object]) -> None:

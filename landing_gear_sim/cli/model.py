@@ -14,6 +14,7 @@ from landing_gear_sim.cli.common import (
     PROG,
     add_params_arguments,
     add_run_arguments,
+    check_outputs,
     mapping_of,
     params_of,
     progress,
@@ -111,6 +112,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from msg_tools.bag_io import write_bag
     from msg_tools.csv_io import write_csv
 
+    check_outputs(files=[args.output, args.plot])
     if args.bag and args.bag.exists():  # fail before anything is written
         raise LandingGearSimError(f"{args.bag}: exists already; remove it or choose another --bag")
     params = params_of(args)
@@ -188,6 +190,7 @@ def cmd_bode(args: argparse.Namespace) -> int:
     from landing_gear_sim.model.linear import frequency_response, resonance_hz
     from landing_gear_sim.report.figures import plot_bode
 
+    check_outputs(files=[args.output])
     params = params_of(args)
     frequencies = np.logspace(np.log10(args.fmin), np.log10(args.fmax), 800)
     variants = [params] if not params.has("gear_walk") else [params, params.without("gear_walk")]

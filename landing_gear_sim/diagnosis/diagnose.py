@@ -39,6 +39,7 @@ from landing_gear_sim.diagnosis.signatures import (
 )
 from landing_gear_sim.errors import DiagnosisError, IdentificationError
 from landing_gear_sim.model.parameters import ELEMENTS, RigParameters
+from landing_gear_sim.processes import die_with_parent
 from msg_tools.run import Run
 
 MAX_ROUNDS = 4
@@ -163,7 +164,8 @@ def _score_all(pending: Sequence[Candidate], runs: Sequence[ClassifiedRun], mode
         return [_score_one(c, runs, model, datasheet, scales, signatures) for c in pending]
     # fork: the children inherit the compiled physics instead of compiling it again
     context = multiprocessing.get_context("fork")
-    with ProcessPoolExecutor(workers, mp_context=context) as pool:
+    with ProcessPoolExecutor(workers, mp_context=context,
+                             initializer=die_with_parent) as pool:
         futures = {pool.submit(_score_one, c, runs, model, datasheet, scales, signatures): c
                    for c in pending}
         for future in as_completed(futures):

@@ -6,7 +6,6 @@ them cleanly, leave the bag. The ROS launch file starts the same description.
 
 from __future__ import annotations
 
-import ctypes
 import os
 import signal
 import subprocess
@@ -19,11 +18,11 @@ from pathlib import Path
 
 from landing_gear_sim.errors import GraphError
 from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.processes import die_with_parent
 from landing_gear_sim.ros.graph import GraphOptions, NodeSpec, ParamValue, describe
 
 LINGER_S = 10.0  # after the plant ends, how long the others may take to finish on their own
 STOP_S = 5.0  # after SIGINT, how long before SIGKILL
-PR_SET_PDEATHSIG = 1
 
 
 def ros_environment(environ: dict[str, str] | None = None) -> dict[str, str]:
@@ -86,7 +85,7 @@ def _run_processes(options: GraphOptions, params_file: Path,
     say(f"starting {', '.join(n.name for n in nodes)} (ROS_DOMAIN_ID {domain}, discovery "
         f"{discovery})")
     processes = {n.name: subprocess.Popen(node_command(n, params_file), env=env,
-                                          preexec_fn=_die_with_parent) for n in nodes}
+                                          preexec_fn=die_with_parent) for n in nodes}
     interrupted = False
     previous = signal.signal(signal.SIGTERM, _interrupt)
     try:
@@ -102,12 +101,6 @@ def _run_processes(options: GraphOptions, params_file: Path,
 
 def _interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt  # SIGTERM stops the graph like Ctrl-C: the bag is closed
-
-
-def _die_with_parent() -> None:
-    """Linux: a node gets SIGTERM if the launcher is killed, rather than running on."""
-    libc = ctypes.CDLL(None, use_errno=True)
-    libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
 def _wait_for_plant(processes: dict[str, subprocess.Popen], say: Callable[[str], None]) -> None:

@@ -32,6 +32,7 @@ from landing_gear_sim.model.parameters import SPECS, RigParameters, load_paramet
 from landing_gear_sim.model.runspec import RunSpec
 from landing_gear_sim.model.scenario import Scenario
 from landing_gear_sim.ros.graph import TOPIC_READY, TOPIC_RUN_END, load_scenario
+from landing_gear_sim.ros.nodes import stop_requested
 from msg_tools.contract import (
     TOPIC_CURRENT,
     TOPIC_FLYWHEEL,
@@ -39,6 +40,8 @@ from msg_tools.contract import (
     TOPIC_WHEEL,
     TOPIC_WRENCH,
 )
+
+RCLError = _rclpy.RCLError  # what rcl raises once its context is shut down
 
 DATA_QOS = QoSProfile(reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST,
                       depth=5000, durability=DurabilityPolicy.VOLATILE)
@@ -182,6 +185,15 @@ _NO_PUB_EVENTS = PublisherEventCallbacks(use_default_callbacks=False)
 _NO_SUB_EVENTS = SubscriptionEventCallbacks(use_default_callbacks=False)
 
 
+def say(node: Node, message: str) -> None:
+    """Log ``message`` through ROS, or plainly once a signal has shut ROS down (rcl can no
+    longer publish to /rosout then, and says so on stderr)."""
+    if node.context.ok():
+        node.get_logger().info(message)
+    else:
+        print(f"[{node.get_name()}] {message}", file=sys.stderr, flush=True)
+
+
 class RunFinishedError(Exception):
     """Raised inside the executor to leave spin() once a node's work is done."""
 
@@ -236,14 +248,16 @@ def spin(node: Node) -> None:
     Services are not served (the nodes run without parameter services by default).
     """
     context = node.context
-    assert context.handle is not None, "spin() needs an initialised context"
+    handle = context.handle
+    if handle is None or not context.ok():  # a signal came while the node was being built
+        return
     shutdown = SignalHandlerGuardCondition(context)
+    node.get_logger().info("running (SIGINT or SIGTERM stops it)")
     try:
         while context.ok():
             subscriptions = list(node.subscriptions)
             timers = [t for t in node.timers if not t.is_canceled()]
-            wait_set = _rclpy.WaitSet(len(subscriptions), 1, len(timers), 0, 0, 0,
-                                      context.handle)
+            wait_set = _rclpy.WaitSet(len(subscriptions), 1, len(timers), 0, 0, 0, handle)
             for subscription in subscriptions:
                 wait_set.add_subscription(subscription.handle)
             for timer in timers:
@@ -281,17 +295,22 @@ def _take_all(subscriptions: list[Subscription], ready: list[int]) -> None:
 
 def run_node(factory: Callable[[], Node], args: list[str] | None = None) -> int:
     """init, build the node, spin until the run ends or a signal; one error line on failure."""
-    rclpy.init(args=args)
     node = None
     try:
+        rclpy.init(args=args)  # its handlers take SIGINT/SIGTERM from here on
+        if stop_requested():  # one came while the node was starting (see nodes/__init__)
+            return 0
         node = factory()
-        node.get_logger().info("running (SIGINT or SIGTERM stops it)")
         spin(node)
     except (RunFinishedError, KeyboardInterrupt, ExternalShutdownException):
         pass
     except LandingGearSimError as exc:
         print(f"{_program()}: error: {exc}", file=sys.stderr)
         return 2
+    except RCLError:
+        if rclpy.ok():
+            raise
+        # a signal shut the context down while the node was being set up: a clean stop
     finally:
         if isinstance(node, GraphNode):
             node.close()

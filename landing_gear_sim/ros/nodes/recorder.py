@@ -31,6 +31,7 @@ from landing_gear_sim.ros.nodes.common import (
     declare,
     lockstep,
     main_for,
+    say,
 )
 from msg_tools.bag_segments import SegmentedBagWriter
 from msg_tools.contract import TOPIC_CURRENT, TOPIC_TYPES, TOPIC_WHEEL
@@ -133,8 +134,8 @@ class RecorderNode(GraphNode):
     def close(self) -> None:
         self._flush(force=True)
         self._writer.close()
-        self.get_logger().info(f"bag closed: {self._writer.path} ({self._written} samples, "
-                               f"{self._writer.message_count} messages)")
+        say(self, f"bag closed: {self._writer.path} ({self._written} samples, "
+                  f"{self._writer.message_count} messages)")
 
 
 main = main_for(RecorderNode)

@@ -55,13 +55,16 @@ class RunKind(str, enum.Enum):
 
     @property
     def family(self) -> Family:
-        return Family.ACTUATOR if self.value.startswith("actuator") else Family.BRAKE
+        return _FAMILIES[self]
 
     @property
     def braking(self) -> bool:
         """The wheel is on the flywheel: speeds, loads and forces carry information."""
         return self.family is Family.BRAKE
 
+
+_FAMILIES = {RunKind.ACTUATOR_RAMP: Family.ACTUATOR, RunKind.ACTUATOR_DYNAMIC: Family.ACTUATOR,
+             RunKind.BRAKE_CONSTANT: Family.BRAKE, RunKind.BRAKE_OSCILLATING: Family.BRAKE}
 
 Selector = RunKind | Family
 """A run kind, or a whole family of kinds."""

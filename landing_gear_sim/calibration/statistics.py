@@ -24,14 +24,20 @@ class Estimate:
                 "runs": list(self.runs)}
 
 
+def lag_one_correlation(residual: np.ndarray) -> float:
+    """Lag-1 autocorrelation ρ₁ of a residual (0 for a constant one)."""
+    centred = residual - residual.mean()
+    power = float(centred @ centred)
+    return float(centred[1:] @ centred[:-1]) / power if power > 0 else 0.0
+
+
 def correlation_inflation(residual: np.ndarray) -> float:
     """Variance factor (1 + ρ)/(1 − ρ) for residuals with lag-1 correlation ρ (AR(1)).
 
     Residuals of simulations and integrated balances are smooth; counting every
     sample as independent would claim far too small an uncertainty.
     """
-    centred = residual - residual.mean()
-    rho = float(centred[1:] @ centred[:-1] / max(float(centred @ centred), 1e-300))
+    rho = lag_one_correlation(residual)
     return (1 + rho) / (1 - rho) if 0 < rho < 1 else 1.0
 
 

@@ -76,11 +76,12 @@ def score(measured: np.ndarray, simulated: np.ndarray) -> Score:
 
 
 def compare(measured: Run, simulated: Run) -> RunComparison:
-    """Score ``simulated`` against ``measured`` on their common samples."""
+    """Score ``simulated`` against ``measured`` on their common samples (``measured`` on
+    its uniform grid, as classified: the comparison keeps the samples it scored)."""
     run = classified(measured)
     n = min(len(run), len(simulated))
     scores = {c: score(getattr(run, c)[:n], getattr(simulated, c)[:n]) for c in channels_of(run)}
-    return RunComparison(measured, simulated, run.kind, scores)
+    return RunComparison(run, simulated, run.kind, scores)
 
 
 def validate(runs: Sequence[Run], params: RigParameters) -> list[RunComparison]:

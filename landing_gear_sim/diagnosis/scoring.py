@@ -24,6 +24,7 @@ from landing_gear_sim.calibration.runs import (
     family_of,
     select,
 )
+from landing_gear_sim.calibration.statistics import lag_one_correlation
 from landing_gear_sim.diagnosis.catalogue import (
     Candidate,
     CandidateFit,
@@ -59,9 +60,8 @@ def channel_fits(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequen
 
 def effective_count(residual: np.ndarray) -> float:
     """Samples worth of independent information: n (1 − ρ₁)/(1 + ρ₁) (AR(1) residual)."""
-    r = residual - residual.mean()
-    rho = float(np.clip(r[1:] @ r[:-1] / (r @ r), 0.0, 0.999)) if r @ r > 0 else 0.0
-    return max(len(r) * (1 - rho) / (1 + rho), 2.0)
+    rho = float(np.clip(lag_one_correlation(residual), 0.0, 0.999))
+    return max(len(residual) * (1 - rho) / (1 + rho), 2.0)
 
 
 def log_ratio(candidate: np.ndarray, null: np.ndarray) -> float:

@@ -7,6 +7,7 @@ and call the blocks of :mod:`landing_gear_sim.model.blocks` once per message.
 from __future__ import annotations
 
 import math
+import signal
 import sys
 import time
 from collections.abc import Callable, Iterable
@@ -317,6 +318,10 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None) -> int:
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
+        # the work is done: a second Ctrl-C (ros2 launch forwards one after the terminal's)
+        # must not kill the exit, which Python makes with default handlers (exit -2)
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
     return 0
 
 

@@ -53,6 +53,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/graph.py
 	$(BIN)/python bench/controllers.py
 	$(BIN)/python bench/diagnose.py
+	$(BIN)/python bench/io.py
 
 clean:
 	rm -rf $(VENV) out build install log .pytest_cache

@@ -41,7 +41,10 @@ setup(
             "ros-rmw-fastrtps-cpp",
             "ros-ament-index-python",
         ],
+        # rig log formats beyond CSV, MATLAB v5 and bags (imported only when such a file is read)
+        "formats": ["h5py>=3.8", "pyarrow>=14", "asammdf>=7.4", "npTDMS>=1.7"],
         "test": [
+            "landing_gear_sim[formats]",
             "pytest>=7",
             "pytest-xdist>=3",
             "ruff>=0.5",

@@ -1,16 +1,17 @@
-"""Contract rosbag2 read and write with ``rosbags`` (mcap or sqlite3), no ROS install needed."""
+"""Contract rosbag2 writing with ``rosbags`` (mcap or sqlite3), no ROS install needed."""
 
 from __future__ import annotations
 
+import os
+import shutil
 from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from rosbags.rosbag2 import Reader, Writer
+from rosbags.rosbag2 import Writer
 from rosbags.rosbag2.enums import StoragePlugin
 from rosbags.typesys import Stores, get_typestore
 
-from .checks import check_plausible
 from .contract import (
     ATMOSPHERE_PA,
     TOPIC_CURRENT,
@@ -66,13 +67,19 @@ def contract_messages(run: Run, k: int) -> dict[str, Any]:
 
 
 def write_bag(run: Run, path: Path, storage: str = "mcap") -> None:
-    """Write ``run`` as a rosbag2 with the contract topics (log time = sample time)."""
+    """Write ``run`` as a rosbag2 with the contract topics (log time = sample time).
+
+    Written under a hidden name and renamed when complete: an interrupted write leaves
+    no bag (and a hidden ``.name.part`` folder that the next write replaces).
+    """
     path = Path(path)
     if storage not in STORAGE:
         raise RunFormatError(f"unknown bag storage {storage!r}; use mcap or sqlite3")
     if path.exists():
         raise RunFormatError(f"{path}: exists already, not overwriting")
-    with Writer(path, version=BAG_VERSION, storage_plugin=STORAGE[storage]) as writer:
+    partial = path.with_name(f".{path.name}.part")
+    shutil.rmtree(partial, ignore_errors=True)
+    with Writer(partial, version=BAG_VERSION, storage_plugin=STORAGE[storage]) as writer:
         connections = {topic: writer.add_connection(topic, msgtype, typestore=TYPESTORE)
                        for topic, msgtype in TOPIC_TYPES.items()}
         for k in range(len(run)):
@@ -80,46 +87,16 @@ def write_bag(run: Run, path: Path, storage: str = "mcap") -> None:
             for topic, message in contract_messages(run, k).items():
                 data = TYPESTORE.serialize_cdr(message, TOPIC_TYPES[topic])
                 writer.write(connections[topic], log_time, data)
+    _rename_storage_files(partial, path.name)
+    os.replace(partial, path)
 
 
-def read_bag(path: Path, name: str | None = None) -> Run:
-    """Read the contract topics of a rosbag2 into a :class:`Run` on the wheel encoder's time base.
-
-    Stamped topics are matched by header stamp (linear interpolation), the
-    current command by bag log time (held, as the valve sees it).
-    """
-    path = Path(path)
-    series: dict[str, tuple[list[float], list[Any]]] = {t: ([], []) for t in TOPIC_TYPES}
-    try:
-        with Reader(path) as reader:
-            wanted = [c for c in reader.connections if c.topic in series]
-            for connection, log_time, raw in reader.messages(connections=wanted):
-                message = TYPESTORE.deserialize_cdr(raw, connection.msgtype)
-                stamp = getattr(message, "header", None)
-                t = (stamp.stamp.sec + stamp.stamp.nanosec * 1e-9) if stamp else log_time * 1e-9
-                series[connection.topic][0].append(t)
-                series[connection.topic][1].append(message)
-    except Exception as exc:  # rosbags raises several types for damaged bags
-        raise RunFormatError(f"{path}: cannot read bag ({exc})") from None
-    missing = [topic for topic, (times, _) in series.items() if not times]
-    if missing:
-        raise RunFormatError(f"{path}: bag has no messages on {', '.join(missing)}")
-    base = np.asarray(series[TOPIC_WHEEL][0])
-
-    def on_base(topic: str, value: Any) -> np.ndarray:
-        times, messages = series[topic]
-        return np.interp(base, times, [value(m) for m in messages])
-
-    current_times, current_msgs = series[TOPIC_CURRENT]
-    held = np.searchsorted(current_times, base + 1e-9, side="right") - 1
-    fields = {
-        "time_s": base,
-        "current_a": np.array([m.data for m in current_msgs])[np.clip(held, 0, None)],
-        "pressure_pa": on_base(TOPIC_PRESSURE, lambda m: m.fluid_pressure - ATMOSPHERE_PA),
-        "wheel_speed_rad_s": on_base(TOPIC_WHEEL, lambda m: m.velocity[0]),
-        "flywheel_speed_rad_s": on_base(TOPIC_FLYWHEEL, lambda m: m.velocity[0]),
-        "vertical_load_n": on_base(TOPIC_WRENCH, lambda m: m.wrench.force.z),
-        "longitudinal_force_n": on_base(TOPIC_WRENCH, lambda m: m.wrench.force.x),
-    }
-    check_plausible(fields, str(path))
-    return Run(name=name or path.name, source=str(path), **fields)
+def _rename_storage_files(folder: Path, name: str) -> None:
+    """Name the storage files after the bag, not after the temporary folder."""
+    meta = folder / "metadata.yaml"
+    text = meta.read_text()
+    for old in sorted(folder.glob(f"{folder.name}*")):
+        new = name + old.name[len(folder.name):]
+        os.replace(old, folder / new)
+        text = text.replace(old.name, new)
+    meta.write_text(text)

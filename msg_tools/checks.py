@@ -18,6 +18,12 @@ PLAUSIBLE_MAX: dict[str, tuple[float, str, float]] = {
 """Largest |value| a landing-gear rig can produce, per field (SI, display unit, factor)."""
 
 MAX_GAP_SAMPLES = 5.0  # a step longer than this many nominal periods is a gap in the log
+SLOWEST_PERIOD_S = 0.1  # rigs log at 10 Hz or faster ...
+FASTEST_PERIOD_S = 1e-6  # ... and at 1 MHz or slower
+CONTACT_LOAD_N = 2e3  # the wheel is on the flywheel
+TURNING_RAD_S = 1.0
+BRAKING_PRESSURE_PA = 5 * PA_PER_BAR  # the brake holds torque
+MIN_BRAKING_SAMPLES = 50
 
 
 def check_plausible(fields: dict[str, np.ndarray], where: str) -> None:
@@ -30,6 +36,7 @@ def check_plausible(fields: dict[str, np.ndarray], where: str) -> None:
                 f"(max {limit / factor:g} {unit}); is the unit wrong? declare it in a "
                 "column-mapping file")
     check_time(fields["time_s"], where)
+    check_signs(fields, where)
 
 
 def check_time(time_s: np.ndarray, where: str) -> None:
@@ -43,8 +50,35 @@ def check_time(time_s: np.ndarray, where: str) -> None:
         raise RunFormatError(f"{where}: time is not strictly increasing ({kind} time "
                              f"{time_s[bad[0] + 1]:.6g} s at sample {bad[0] + 1})")
     nominal = float(np.median(steps))
+    if nominal > SLOWEST_PERIOD_S:
+        raise RunFormatError(f"{where}: time advances {nominal:.4g} per sample, as if the rig "
+                             f"logged at {1 / nominal:.3g} Hz; is the time in ms? declare its "
+                             "unit (a units row, a header such as 'time [ms]', or a "
+                             "column-mapping file)")
+    if nominal < FASTEST_PERIOD_S:
+        raise RunFormatError(f"{where}: time advances {nominal:.3g} s per sample "
+                             f"({1 / nominal:.3g} Hz); is it in seconds but declared as ms or "
+                             "us?")
     gaps = np.flatnonzero(steps > MAX_GAP_SAMPLES * nominal)
     if gaps.size:
         k = gaps[0]
         raise RunFormatError(f"{where}: gap of {steps[k]:.4g} s in the log after "
                              f"t = {time_s[k]:.6g} s (nominal period {nominal:.3g} s)")
+
+
+def check_signs(fields: dict[str, np.ndarray], where: str) -> None:
+    """Raise if the loads have the wrong sign for the contract: vertical load positive
+    in contact, longitudinal force positive while braking."""
+    contact = (np.abs(fields["vertical_load_n"]) > CONTACT_LOAD_N) & (
+        np.abs(fields["flywheel_speed_rad_s"]) > TURNING_RAD_S)
+    if contact.sum() < MIN_BRAKING_SAMPLES:
+        return
+    if np.median(fields["vertical_load_n"][contact]) < 0:
+        raise RunFormatError(f"{where}: vertical_load_N is negative while the wheel is loaded; "
+                             "the contract counts it positive (scale: -1 in a column mapping)")
+    braking = contact & (fields["pressure_pa"] > BRAKING_PRESSURE_PA)
+    if braking.sum() >= MIN_BRAKING_SAMPLES and np.median(
+            fields["longitudinal_force_n"][braking]) < 0:
+        raise RunFormatError(f"{where}: longitudinal_force_N is negative while braking; the "
+                             "contract counts it positive when braking (scale: -1 in a "
+                             "column mapping)")

@@ -1,34 +1,74 @@
-"""Read a run from any supported source, and a campaign (a folder of runs)."""
+"""Read a run from any supported source, and a campaign (a folder of runs, sub-folders too)."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from .bag_io import read_bag
-from .csv_io import Mapping, read_csv
+from .bag_read import STORAGE_SUFFIXES, read_bag
+from .binary_tables import READERS
+from .columns import run_from_table
+from .csv_io import read_csv, run_name
 from .errors import RunFormatError
+from .mapping import Mapping
 from .run import Run
+
+TEXT_SUFFIXES = (".csv", ".txt", ".tsv", ".dat", ".asc")
+NOT_RUNS = (".yaml", ".yml", ".json", ".md", ".rst", ".html", ".png", ".svg", ".pdf", ".log",
+            ".py", ".part", ".zip")
+"""Files a campaign folder may hold beside its runs (configs, reports, notes): not reported."""
+SEPARATOR = "__"  # joins sub-folder and file names into a run name (it names report files)
 
 
 def is_bag(path: Path) -> bool:
-    """A rosbag2 folder (metadata.yaml) or a single .mcap / .db3 file."""
+    """A rosbag2 folder (``metadata.yaml``, or storage files only), a single ``.mcap`` /
+    ``.db3`` file, or a ROS 1 ``.bag``."""
     path = Path(path)
-    return (path.is_dir() and (path / "metadata.yaml").exists()) or path.suffix in {".mcap",
-                                                                                    ".db3"}
+    if path.is_dir():
+        return (path / "metadata.yaml").exists() or _lost_its_metadata(path)
+    return path.suffix.lower() in (*STORAGE_SUFFIXES, ".bag")
 
 
-def read_run(path: Path, mapping: Mapping | None = None) -> Run:
-    """A run from a CSV file or a rosbag2."""
+def _lost_its_metadata(folder: Path) -> bool:
+    """A bag folder without ``metadata.yaml``: one storage file, or rosbag2's segment
+    names (``<folder>_0.mcap``, ``<folder>_1.mcap``); several other storage files are
+    separate runs."""
+    files = [p for p in folder.iterdir() if p.suffix.lower() in STORAGE_SUFFIXES]
+    return len(files) == 1 or (len(files) > 1 and all(
+        p.stem.rsplit("_", 1)[0] == folder.name for p in files))
+
+
+def _kind(path: Path) -> str:
+    """``bag``, ``text``, ``binary``, ``other`` (not a run) or ``unknown``."""
+    suffixes = [s.lower() for s in path.suffixes[-2:]]
+    last = suffixes[-1] if suffixes else ""
+    if is_bag(path):
+        return "bag"
+    if last in TEXT_SUFFIXES or (last == ".gz" and suffixes[0] in TEXT_SUFFIXES):
+        return "text"
+    if last in READERS:
+        return "binary"
+    return "other" if last in NOT_RUNS or path.is_dir() else "unknown"
+
+
+def read_run(path: Path, mapping: Mapping | None = None, name: str | None = None) -> Run:
+    """A run from a bag, a delimited text file or a binary table (see ``README`` formats)."""
     path = Path(path)
     if not path.exists():
         raise RunFormatError(f"{path}: no such file or folder")
-    if is_bag(path):
-        return read_bag(path)
-    return read_csv(path, mapping=mapping)
+    kind = _kind(path)
+    if kind == "bag":
+        return read_bag(path, name, mapping)
+    if kind == "text":
+        return read_csv(path, name, mapping)
+    if kind == "binary":
+        table = READERS[path.suffix.lower()](path)
+        return run_from_table(table, str(path), name or run_name(path), mapping)
+    raise RunFormatError(f"{path}: not a run file (reads .csv/.txt/.tsv[.gz], .mat, .h5, "
+                         ".parquet, .mf4, .tdms, rosbag2 folders, .mcap, .db3, ROS 1 .bag)")
 
 
 @dataclass(frozen=True)
@@ -41,26 +81,46 @@ class Campaign:
 
 
 def campaign_sources(folder: Path) -> list[Path]:
-    """Run files of a campaign folder: CSVs and rosbag2 folders, sorted by name."""
+    """Run files and bags in ``folder`` and its sub-folders, sorted; hidden entries
+    (``.name``, macOS ``._name``) and files such as configs and reports left out."""
     folder = Path(folder)
     if not folder.is_dir():
         raise RunFormatError(f"{folder}: not a folder")
-    found = [p for p in folder.iterdir() if p.suffix == ".csv" or is_bag(p)]
-    return sorted(found)
+    found: list[Path] = []
+    for entry in sorted(folder.iterdir()):
+        if entry.name.startswith(".") or entry.name == "__MACOSX":
+            continue
+        kind = _kind(entry)
+        if entry.is_dir() and kind != "bag":
+            found.extend(campaign_sources(entry))
+        elif kind != "other":
+            found.append(entry)
+    return found
 
 
-def read_campaign(folder: Path, mapping: Mapping | None = None) -> Campaign:
+def read_campaign(folder: Path, mapping: Mapping | None = None,
+                  progress: Callable[[str], None] | None = None) -> Campaign:
     """Read every run of ``folder``; a bad file is reported and skipped, not fatal."""
+    folder = Path(folder)
     runs, problems = [], []
-    for source in campaign_sources(folder):
+    sources = campaign_sources(folder)
+    for number, source in enumerate(sources, 1):
+        if progress and len(sources) > 1:
+            progress(f"reading {number}/{len(sources)}: {source.relative_to(folder)}")
         try:
-            runs.append(read_run(source, mapping))
+            runs.append(read_run(source, mapping, _campaign_name(folder, source)))
         except RunFormatError as exc:
             problems.append(str(exc))
     if not runs:
         raise RunFormatError(f"{folder}: no readable run" +
                              (f" ({'; '.join(problems)})" if problems else ""))
-    return Campaign(Path(folder), tuple(runs), tuple(problems))
+    return Campaign(folder, tuple(runs), tuple(problems))
+
+
+def _campaign_name(folder: Path, source: Path) -> str:
+    parts = source.relative_to(folder).parts
+    stem = source.name if source.is_dir() else run_name(source)
+    return SEPARATOR.join([*parts[:-1], stem])
 
 
 def read_runs(paths: Sequence[Path], mapping: Mapping | None = None) -> Campaign:

@@ -1,4 +1,4 @@
-"""Units accepted in column-mapping files, as factors to SI."""
+"""Units accepted in column-mapping files and units rows, as factors to SI."""
 
 from __future__ import annotations
 
@@ -7,14 +7,20 @@ import math
 PA_PER_BAR = 1e5
 """Pascal per bar: the one conversion between the unit users read and SI inside."""
 
+PSI_PA = 6894.757293168361
+RPM_RAD_S = 2 * math.pi / 60
+
 UNITS: dict[str, dict[str, float]] = {
     "time": {"s": 1.0, "ms": 1e-3, "us": 1e-6},
     "current": {"A": 1.0, "mA": 1e-3},
-    "pressure": {"bar": PA_PER_BAR, "Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "psi": 6894.757293168361},
-    "speed": {"rad/s": 1.0, "rpm": 2 * math.pi / 60, "deg/s": math.pi / 180,
-              "Hz": 2 * math.pi},
+    "pressure": {"bar": PA_PER_BAR, "mbar": 100.0, "Pa": 1.0, "kPa": 1e3, "MPa": 1e6,
+                 "psi": PSI_PA},
+    "speed": {"rad/s": 1.0, "rpm": RPM_RAD_S, "deg/s": math.pi / 180, "Hz": 2 * math.pi},
     "force": {"N": 1.0, "kN": 1e3, "lbf": 4.4482216152605},
 }
+
+ANGLE_UNITS: dict[str, float] = {"rad": 1.0, "deg": math.pi / 180, "rev": 2 * math.pi}
+"""Units of an encoder position that is differentiated into a speed."""
 
 QUANTITY: dict[str, str] = {
     "time_s": "time", "current_a": "current", "pressure_pa": "pressure",
@@ -22,3 +28,21 @@ QUANTITY: dict[str, str] = {
     "vertical_load_n": "force", "longitudinal_force_n": "force",
 }
 """Run field → physical quantity (which units it accepts)."""
+
+_ALIASES = {"sec": "s", "µs": "us", "μs": "us", "1/min": "rpm", "r/min": "rpm",
+            "rad s-1": "rad/s", "rad/sec": "rad/s", "°/s": "deg/s"}
+
+
+def unit_names(units: dict[str, float]) -> str:
+    return ", ".join(units)
+
+
+def parse_unit(text: str, quantity: str) -> str | None:
+    """The unit of ``quantity`` written as ``text`` in a units row (``[ms]``, ``(bar)``,
+    ``sec``), or None if it names none of them."""
+    name = text.strip().strip("[]()").strip()
+    name = _ALIASES.get(name, name)
+    units = UNITS[quantity]
+    if name in units:
+        return name
+    return {unit.lower(): unit for unit in units}.get(name.lower())

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from landing_gear_sim.cli import main
-from msg_tools.bag_io import read_bag
+from msg_tools.bag_read import read_bag
 from msg_tools.csv_io import read_csv
 
 

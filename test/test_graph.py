@@ -26,7 +26,8 @@ from landing_gear_sim.ros.graph import (
     options_from_arguments,
 )
 from landing_gear_sim.ros.launcher import format_value, node_command, ros_environment
-from msg_tools.bag_io import TYPESTORE, read_bag
+from msg_tools.bag_io import TYPESTORE
+from msg_tools.bag_read import read_bag
 from msg_tools.bag_segments import OPEN_SEGMENT, SegmentedBagWriter
 from msg_tools.contract import ATMOSPHERE_PA, TOPIC_TYPES
 

@@ -196,3 +196,80 @@ def test_jittered_timestamps_are_put_on_a_uniform_grid_and_every_step_runs(campa
                 "friction.theta1", "friction.theta2", "friction.theta3"):
         assert jittered.params.number(key) == pytest.approx(identified.params.number(key),
                                                             rel=0.02), key  # issue 13's 2 %
+
+
+COMPARED = ("actuator.map_k1_pa_per_a", "actuator.natural_frequency_hz",
+            "actuator.damping_ratio", "brake.gain_n_m_per_pa", "flywheel.inertia_kg_m2",
+            "wheel.unloaded_radius_m", "friction.theta1", "friction.theta2", "friction.theta3")
+
+
+@pytest.mark.parametrize("noise_a", [1e-3, 2e-3, 1e-2])
+def test_current_logging_noise_changes_neither_classes_nor_parameters(campaign_dir, identified,
+                                                                      reference, noise_a):
+    """1 mA of noise on the logged current once made the ramp 'dynamic' (static map
+    skipped) and, at 5 mA, every braking run 'oscillating'; exit 0 all the same.
+
+    At 10 mA the classes hold but ϑ3 moves by up to 15 % (issue 13, open): the model's
+    wheel-lock episodes respond to the noise left in the denoised command."""
+    rng = np.random.default_rng(2)
+    runs = [dataclasses.replace(r, current_a=r.current_a + rng.normal(0, noise_a, len(r)))
+            for r in read_campaign(campaign_dir).runs]
+    noisy = identify(runs, reference, jackknife=False)
+    assert noisy.classes == identified.classes
+    assert noisy.complete, noisy.problems
+    clean = {e.key: e for e in identified.estimates}
+    for key in COMPARED if noise_a < 5e-3 else set(COMPARED) - {"friction.theta3"}:
+        value, reference_value = noisy.params.number(key), clean[key].value
+        assert abs(value - reference_value) <= max(0.02 * abs(reference_value),
+                                                   2 * clean[key].std), key
+
+
+def _rewritten(campaign_dir, folder, run_name, column, factor):
+    """The campaign with one column of one run multiplied by ``factor``."""
+    folder.mkdir()
+    for source in campaign_dir.glob("*.csv"):
+        lines = source.read_text().splitlines()
+        if source.stem == run_name:
+            k = lines[0].split(",").index(column)
+            lines = lines[:1] + [",".join(
+                f"{float(v) * factor:.12g}" if i == k else v
+                for i, v in enumerate(line.split(","))) for line in lines[1:]]
+        (folder / source.name).write_text("\n".join(lines) + "\n")
+    return folder
+
+
+@pytest.mark.parametrize(("run_name", "column", "factor", "fragments"), [
+    ("brake_const_20bar", "brake_pressure_bar", 1e5 / 6894.757293168361,
+     ["brake_pressure_bar is 14", "times what the valve map gives", "it looks like psi"]),
+    ("brake_const_30bar", "wheel_speed_rad_s", 60 / (2 * np.pi),
+     ["wheel_speed_rad_s is 9.", "while rolling freely", "it looks like rpm"]),
+    ("brake_osc_low", "flywheel_speed_rad_s", 60 / (2 * np.pi),
+     ["flywheel_speed_rad_s is 9.", "it looks like rpm"]),
+])
+def test_a_unit_within_physical_ranges_is_still_named(campaign_dir, tmp_path, capsys,
+                                                      run_name, column, factor, fragments):
+    folder = _rewritten(campaign_dir, tmp_path / "campaign", run_name, column, factor)
+    assert main(["identify", str(folder), "-o", str(tmp_path / "out.yaml")]) == 2
+    error = capsys.readouterr().err
+    assert all(f in error for f in fragments), error
+    assert f"{run_name}.csv" in error and "Traceback" not in error
+    assert not (tmp_path / "out.yaml").exists()
+
+
+def test_a_campaign_that_cannot_identify_everything_writes_only_when_asked(campaign_dir,
+                                                                         tmp_path, capsys):
+    folder = tmp_path / "braking_only"
+    folder.mkdir()
+    for run in campaign_dir.glob("brake_const_*.csv"):
+        shutil.copy(run, folder / run.name)
+    out = tmp_path / "out.yaml"
+    assert main(["identify", str(folder), "-o", str(out)]) == 2
+    error = capsys.readouterr().err
+    assert "not identified: valve static map; actuator dynamics A(s)" in error
+    assert "--partial" in error and not out.exists()
+    assert main(["identify", str(folder), "-o", str(out), "--partial"]) == 0
+    text = out.read_text()
+    assert text.startswith("# PARTIAL identification") and "#   valve static map" in text
+    evidence = json.loads(out.with_suffix(".identification.json").read_text())
+    assert evidence["not_identified"] == ["valve static map", "actuator dynamics A(s)"]
+    assert load_parameters([out]).number("brake.gain_n_m_per_pa") > 0

@@ -9,7 +9,8 @@ import pytest
 
 from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
-from msg_tools.bag_io import read_bag, write_bag
+from msg_tools.bag_io import write_bag
+from msg_tools.bag_read import read_bag
 from msg_tools.contract import CSV_COLUMNS
 from msg_tools.csv_io import read_csv, write_csv
 from msg_tools.errors import RunFormatError
@@ -69,7 +70,8 @@ def test_sensor_noise_follows_the_configured_std(reference):
     (lambda lines: [lines[0], ",".join([*lines[1].split(",")[:2], "nan",
                                         *lines[1].split(",")[3:]]), *lines[2:]], "NaN"),
     (lambda lines: [lines[0], lines[2], lines[1], *lines[3:]], "not strictly increasing"),
-    (lambda lines: [lines[0], "a,b,c,d,e,f,g", *lines[2:]], "unreadable values"),
+    (lambda lines: [lines[0], "a,b,c,d,e,f,g", *lines[2:]], "has the unit 'a'"),
+    (lambda lines: [*lines[:9], "a,b,c,d,e,f,g", *lines[10:]], "unreadable value 'b' at line 10"),
 ])
 def test_bad_csv_gives_one_message_naming_the_file(tmp_path, run, mutate, fragment):
     good = tmp_path / "good.csv"

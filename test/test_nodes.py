@@ -18,7 +18,7 @@ from landing_gear_sim.model.parameters import load_parameters
 from landing_gear_sim.model.runspec import RunSpec, build_scenario
 from landing_gear_sim.ros.graph import load_scenario
 from landing_gear_sim.ros.launcher import ros_environment
-from msg_tools.bag_io import read_bag
+from msg_tools.bag_read import read_bag
 from msg_tools.csv_io import format_csv, write_csv
 
 pytest.importorskip("rclpy")
@@ -187,11 +187,11 @@ def _bad_files(folder: Path) -> dict[str, tuple[Path, str]]:
     cases = {
         "missing": ("", "no such file"),
         "empty": ("", "the file is empty"),
-        "header_only": (header + "\n", "expected >= 2 rows"),
+        "header_only": (header + "\n", "no data rows"),
         "no_column": (good.replace("brake_pressure_bar", "pressure"), "missing column"),
         "nan": ("\n".join([header, _with_field(rows[0], 2, "nan"), *rows[1:]]), "NaN"),
         "time_back": ("\n".join([header, rows[1], rows[0], *rows[2:]]), "not strictly increasing"),
-        "garbage": ("\x00\x01binary", "missing column"),
+        "garbage": ("\x00\x01binary", "no data rows"),
     }
     files = {}
     for name, (text, fragment) in cases.items():

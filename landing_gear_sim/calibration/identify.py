@@ -28,6 +28,7 @@ from landing_gear_sim.calibration.actuator import (
     fit_static_map,
 )
 from landing_gear_sim.calibration.friction import fit_friction, friction_samples, refine_friction
+from landing_gear_sim.calibration.plausibility import check_units
 from landing_gear_sim.calibration.runs import ClassifiedRun, Family, RunKind, classify_all, select
 from landing_gear_sim.calibration.statistics import Estimate
 from landing_gear_sim.errors import IdentificationError, ParameterError
@@ -47,12 +48,19 @@ class Identification:
     classes: dict[str, RunKind]
     problems: tuple[str, ...] = ()
     frf: FrfEstimate | None = None
+    not_identified: tuple[str, ...] = ()
+    """Steps that were skipped or failed: their parameters keep the values of the base."""
+
+    @property
+    def complete(self) -> bool:
+        return not self.not_identified
 
     def to_json(self, campaign: str, read_problems: Sequence[str] = ()) -> dict[str, object]:
         """The evidence file written beside the params (``<name>.identification.json``)."""
         return {"campaign": campaign,
                 "classes": {name: kind.value for name, kind in self.classes.items()},
                 "problems": [*read_problems, *self.problems],
+                "not_identified": list(self.not_identified),
                 "estimates": [e.to_json() for e in self.estimates]}
 
 
@@ -63,6 +71,7 @@ class _Calibration:
         self.params = base
         self.estimates: list[Estimate] = []
         self.problems: list[str] = []
+        self.missed: list[str] = []
         self.frf: FrfEstimate | None = None
         self.say = say
 
@@ -75,12 +84,14 @@ class _Calibration:
         """Run one step on ``runs``; skipped (and said) without them, reported if it fails."""
         if not runs:
             self.problems.append(f"{name}: skipped, no {missing} run in the campaign")
+            self.missed.append(name)
             return
         self.say(f"identifying {name}")
         try:
             action()
         except (IdentificationError, ParameterError, np.linalg.LinAlgError) as exc:
             self.problems.append(f"{name}: failed ({exc})")
+            self.missed.append(name)
 
 
 def identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool = False,
@@ -95,6 +106,7 @@ def identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool = False,
     """
     state = _Calibration(base, progress or (lambda _msg: None))
     classified = classify_all(runs)
+    check_units(classified, base)
     ramps = select(classified, [RunKind.ACTUATOR_RAMP])
     dynamic = select(classified, [RunKind.ACTUATOR_DYNAMIC])
     braking = select(classified, [Family.BRAKE])
@@ -106,20 +118,34 @@ def identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool = False,
     state.step("valve static map", ramps, "quasi-static ramp",
                lambda: state.adopt(fit_static_map(ramps, state.params)))
     state.step("actuator dynamics A(s)", dynamic, "actuator steps/sweep", dynamics)
-    state.step("radius, flywheel, brake gain, friction", braking, "braking",
-               lambda: _braking_steps(state, braking, fix_theta3, friction, jackknife))
+    _braking_steps(state, braking, fix_theta3, friction, jackknife)
     return Identification(state.params, tuple(state.estimates),
-                          {r.name: r.kind for r in classified}, tuple(state.problems), state.frf)
+                          {r.name: r.kind for r in classified}, tuple(state.problems), state.frf,
+                          tuple(state.missed))
 
 
 def _braking_steps(state: _Calibration, runs: Sequence[ClassifiedRun], fix_theta3: bool,
                    friction: bool, jackknife: bool) -> None:
-    prepared = [br.prepare(r, state.params) for r in runs]  # independent of what follows
-    state.adopt([br.fit_unloaded_radius(prepared, state.params)])
-    state.adopt(br.fit_flywheel(prepared, state.params))
-    state.adopt(br.fit_brake_gain(prepared, state.params))
-    if not friction:
+    """Each its own step, so that a note names the one that failed; a step that fails
+    leaves the base values to the steps after it."""
+    prepared: list[br.Braking] = []
+    state.step("braking runs (speeds, slip, forces)", runs, "braking",
+               lambda: prepared.extend(br.prepare(r, state.params) for r in runs))
+    if not prepared:
         return
+    state.step("unloaded rolling radius", runs, "braking",
+               lambda: state.adopt([br.fit_unloaded_radius(prepared, state.params)]))
+    state.step("flywheel inertia and drag", runs, "braking",
+               lambda: state.adopt(br.fit_flywheel(prepared, state.params)))
+    state.step("brake gain", runs, "braking",
+               lambda: state.adopt(br.fit_brake_gain(prepared, state.params)))
+    if friction:
+        state.step("friction curve", runs, "braking",
+                   lambda: _friction_step(state, runs, prepared, fix_theta3, jackknife))
+
+
+def _friction_step(state: _Calibration, runs: Sequence[ClassifiedRun],
+                   prepared: Sequence[br.Braking], fix_theta3: bool, jackknife: bool) -> None:
     points = friction_samples(prepared, state.params)
     state.adopt(fit_friction(*points, state.params, tuple(r.name for r in runs), fix_theta3))
     if not fix_theta3:

@@ -19,15 +19,17 @@ import numpy as np
 
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s
-from landing_gear_sim.model.scenario import brake_start_index
+from landing_gear_sim.model.scenario import brake_start_index, current_noise_a
 from msg_tools.io import is_uniform, resample
 from msg_tools.run import Run
 
 STILL_FLYWHEEL_RAD_S = 1.0  # an actuator-only run: the flywheel stands still ...
 NO_CONTACT_LOAD_N = 2e3  # ... and the wheel carries (almost) no load
-RAMP_STEP_A = 2e-3  # largest current change per sample of a quasi-static ramp
+RAMP_RATE_A_S = 1.0  # fastest current change of a quasi-static ramp ...
+RAMP_SMOOTHING_S = 0.2  # ... measured on the current averaged over this (logging noise)
 RAMP_SPAN_A = 0.5  # ... which must cover this much of the valve's range
-CONSTANT_STD_A = 5e-3  # a braking run whose current varies less than this is constant
+CONSTANT_STD_A = 5e-3  # a braking run whose current varies less than this is constant ...
+CONSTANT_NOISE_FACTOR = 3.0  # ... or less than this many σ of its logging noise
 SETTLE_S = 0.3  # after the braking start the current has settled
 UNIFORM_TOLERANCE = 1e-3  # of a period: steps closer than this count as evenly spaced
 
@@ -125,13 +127,25 @@ def classify(run: Run) -> RunKind:
     quasi-static ramp or dynamic; braking at constant or oscillating current."""
     if (np.max(run.flywheel_speed_rad_s) < STILL_FLYWHEEL_RAD_S
             and np.max(np.abs(run.vertical_load_n)) < NO_CONTACT_LOAD_N):
-        slow = np.max(np.abs(np.diff(run.current_a))) < RAMP_STEP_A
-        ramp = slow and np.ptp(run.current_a) > RAMP_SPAN_A
+        ramp = _fastest_change_a_s(run) < RAMP_RATE_A_S and np.ptp(run.current_a) > RAMP_SPAN_A
         return RunKind.ACTUATOR_RAMP if ramp else RunKind.ACTUATOR_DYNAMIC
     settled = run.time_s > brake_start_s(run) + SETTLE_S
-    if settled.sum() < 10 or np.std(run.current_a[settled]) < CONSTANT_STD_A:
+    limit = max(CONSTANT_STD_A, CONSTANT_NOISE_FACTOR * current_noise_a(run.current_a))
+    if settled.sum() < 10 or np.std(run.current_a[settled]) < limit:
         return RunKind.BRAKE_CONSTANT
     return RunKind.BRAKE_OSCILLATING
+
+
+def _fastest_change_a_s(run: Run) -> float:
+    """Largest rate of change of the current averaged over RAMP_SMOOTHING_S [A/s]: a
+    ramp's slope, not its logging noise (averaging n samples divides the noise's rate
+    by about n)."""
+    period = float(np.median(np.diff(run.time_s)))
+    width = max(1, round(RAMP_SMOOTHING_S / period))
+    if run.current_a.size <= width:
+        return float(np.max(np.abs(np.diff(run.current_a)))) / period
+    averaged = np.convolve(run.current_a, np.full(width, 1.0 / width), mode="valid")
+    return float(np.max(np.abs(np.diff(averaged)))) / period
 
 
 def brake_start_s(run: Run) -> float:

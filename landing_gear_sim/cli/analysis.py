@@ -16,12 +16,13 @@ from landing_gear_sim.cli.common import (
     progress,
     write_atomically,
 )
-from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.errors import IdentificationError, LandingGearSimError
 from landing_gear_sim.model.parameters import RigParameters, parse_assignment
 from msg_tools.units import PA_PER_BAR
 
 if TYPE_CHECKING:
     from antiskid.metrics import BrakingMetrics
+    from landing_gear_sim.calibration.identify import Identification
     from msg_tools.run import Run
 
 
@@ -33,6 +34,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     ident.add_argument("-o", "--output", type=Path, default=Path("out/calibrated.yaml"))
     ident.add_argument("--fix-theta3", action="store_true", help="keep Burckhardt theta3")
     ident.add_argument("--mapping", type=Path, help="column-mapping file for the CSVs")
+    ident.add_argument("--partial", action="store_true",
+                       help="write the parameters a campaign could identify even when a step "
+                       "was skipped or failed (the file lists what kept its base value)")
     ident.set_defaults(func=cmd_identify)
 
     val = sub.add_parser("validate", help="simulate a campaign with its inputs; fit report")
@@ -108,15 +112,28 @@ def cmd_identify(args: argparse.Namespace) -> int:
     if not result.estimates:
         raise LandingGearSimError(f"{args.campaign}: no identification step could run; "
                                   f"nothing written")
+    if not result.complete and not args.partial:
+        raise IdentificationError(
+            f"{args.campaign}: not identified: {'; '.join(result.not_identified)} (see the "
+            "notes above); nothing written. --partial writes the rest, marking these")
     print(text_table(["parameter", "value", "1-sigma", "method", "runs"],
                      estimates_table(result.estimates)))
-    write_atomically(args.output, result.params.to_yaml)
+    write_atomically(args.output, lambda path: _write_params(result, path))
     evidence = result.to_json(str(args.campaign), campaign.problems)
     sidecar = args.output.with_suffix(".identification.json")
     write_atomically(sidecar, lambda p: p.write_text(json.dumps(evidence, indent=1)))
     print(f"identified in {time.perf_counter() - started:.1f} s")
     print(f"params:   {args.output}\nevidence: {sidecar}")
     return 0
+
+
+def _write_params(result: Identification, path: Path) -> None:
+    """The params file; a partial one starts with the steps whose values were kept."""
+    result.params.to_yaml(path)
+    if result.not_identified:
+        marks = "".join(f"#   {step}\n" for step in result.not_identified)
+        path.write_text("# PARTIAL identification (--partial): these steps did not run, their "
+                        f"parameters keep the base values:\n{marks}" + path.read_text())
 
 
 def cmd_validate(args: argparse.Namespace) -> int:

@@ -174,7 +174,7 @@ def cmd_rig(args: argparse.Namespace) -> int:
 
 
 def _bag_summary(bag: Path) -> str:
-    from msg_tools.bag_io import read_bag
+    from msg_tools.bag_read import read_bag
     from msg_tools.errors import RunFormatError
 
     try:

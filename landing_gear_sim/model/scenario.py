@@ -13,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.ndimage
 import scipy.signal
 
 from landing_gear_sim.errors import ScenarioError
@@ -128,9 +129,45 @@ BRAKE_ON_CURRENT_A = 0.01
 clear of logging noise and of the zero current before braking)."""
 
 
+BRAKE_ON_NOISE_FACTOR = 5.0
+BRAKE_ON_CEILING_A = 0.05  # half the valve's dead-band: a command below it does nothing
+NOISY_CURRENT_A = 5e-4  # a logged current noisier than this is denoised ...
+COMMAND_MEDIAN_SAMPLES = 21  # ... by a running median this wide (keeps a command's edges)
+MEDIAN_NOISE_GAIN = 1.2533 / np.sqrt(COMMAND_MEDIAN_SAMPLES)  # its σ on white noise
+
+
+def current_noise_a(current_a: np.ndarray) -> float:
+    """Standard deviation of the white noise on a logged current [A], from the median
+    absolute first difference (robust to the command's own steps and ramps)."""
+    steps = np.diff(np.asarray(current_a, dtype=float))
+    if steps.size < 2:
+        return 0.0
+    return float(1.4826 * np.median(np.abs(steps - np.median(steps))) / np.sqrt(2.0))
+
+
+def denoised_command(current_a: np.ndarray) -> tuple[np.ndarray, float]:
+    """The command behind a logged current and the σ of the noise left in it [A].
+
+    A log noisier than 0.5 mA gets a running median of 21 samples: brake commands are held
+    levels, steps and releases, whose edges a median keeps where a low-pass would smear
+    them. A clean log is returned as it is."""
+    current = np.asarray(current_a, dtype=float)
+    noise = current_noise_a(current)
+    if noise <= NOISY_CURRENT_A:
+        return current, noise
+    command = scipy.ndimage.median_filter(current, size=COMMAND_MEDIAN_SAMPLES, mode="nearest")
+    return command, noise * MEDIAN_NOISE_GAIN
+
+
 def brake_start_index(current_a: np.ndarray) -> int | None:
-    """Index of the first sample whose current commands the brake, or None if none does."""
-    on = np.flatnonzero(np.asarray(current_a) > BRAKE_ON_CURRENT_A)
+    """Index of the first sample whose current commands the brake, or None if none does.
+
+    A command is a current above 10 mA, or above 5 σ of the logging noise where the log is
+    noisier (on the denoised command, :func:`denoised_command`; capped at 50 mA), so that
+    noise alone never starts a braking and noise does not delay the start."""
+    current, noise = denoised_command(current_a)
+    threshold = min(max(BRAKE_ON_CURRENT_A, BRAKE_ON_NOISE_FACTOR * noise), BRAKE_ON_CEILING_A)
+    on = np.flatnonzero(current > threshold)
     return int(on[0]) if on.size else None
 
 

@@ -1,0 +1,80 @@
+"""Unit mix-ups a range check cannot see, found by what the rig's physics makes redundant.
+
+A speed logged in rpm but declared rad/s, or a pressure in psi declared as bar, stays
+within any physical range; but before braking the wheel rolls freely on the flywheel (equal
+rim speeds), and the valve's pressure follows its current through the datasheet map within
+tens of percent. A ratio far from 1 that matches a unit factor names the unit.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.errors import IdentificationError
+from landing_gear_sim.model.actuator import actuator_pressure
+from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.quantities import rim_speed_m_s, rolling_radius_at
+from msg_tools.units import PA_PER_BAR, UNITS
+
+PLAUSIBLE_RATIO = (0.5, 2.0)  # measured/expected: other rigs differ, not by a unit factor
+MATCH = 0.15  # a ratio within 15 % of a unit factor is taken for that unit
+MIN_SAMPLES = 50
+LOADED_N = 2e3
+TURNING_RAD_S = 1.0
+VALVE_PRESSURE_PA = 5 * PA_PER_BAR  # compare where the valve map is clear of its dead-band
+
+
+def check_units(runs: Sequence[ClassifiedRun], params: RigParameters) -> None:
+    """Raise :class:`IdentificationError` naming the column and its likely unit."""
+    for run in runs:
+        _check_speeds(run, params)
+        _check_pressure(run, params)
+
+
+def _likely(ratio: float, quantity: str, contract_unit: str) -> str | None:
+    """The unit whose factor to ``contract_unit`` explains ``ratio`` (value read / truth)."""
+    units = UNITS[quantity]
+    for unit, factor in units.items():
+        if unit != contract_unit and abs(ratio * factor / units[contract_unit] - 1) < MATCH:
+            return unit
+    return None
+
+
+def _refuse(run: ClassifiedRun, column: str, ratio: float, what: str, unit: str | None) -> None:
+    hint = f"; it looks like {unit}: declare the unit (units row, header '[{unit}]' or a " \
+           "column mapping)" if unit else "; check its unit and the rig parameters"
+    raise IdentificationError(f"{run.source or run.name}: {column} is {ratio:.3g} times "
+                              f"{what}{hint}")
+
+
+def _check_speeds(run: ClassifiedRun, params: RigParameters) -> None:
+    rolling = ((run.time_s < run.brake_start_s) & (run.vertical_load_n > LOADED_N)
+               & (np.abs(run.flywheel_speed_rad_s) > TURNING_RAD_S))
+    if not run.braking or rolling.sum() < MIN_SAMPLES:
+        return
+    wheel = run.wheel_speed_rad_s[rolling] * rolling_radius_at(params, run.vertical_load_n[rolling])
+    ratio = float(np.median(wheel) / np.median(rim_speed_m_s(params, run.flywheel_speed_rad_s[
+        rolling])))
+    if PLAUSIBLE_RATIO[0] <= ratio <= PLAUSIBLE_RATIO[1]:
+        return
+    wheel_unit, flywheel_unit = _likely(ratio, "speed", "rad/s"), _likely(1 / ratio, "speed",
+                                                                         "rad/s")
+    if flywheel_unit and not wheel_unit:
+        _refuse(run, "flywheel_speed_rad_s", 1 / ratio,
+                "what the wheel's speed gives while rolling freely", flywheel_unit)
+    _refuse(run, "wheel_speed_rad_s", ratio,
+            "what the flywheel's speed gives while rolling freely", wheel_unit)
+
+
+def _check_pressure(run: ClassifiedRun, params: RigParameters) -> None:
+    expected = actuator_pressure(params, run.current_a, run.rate_hz)
+    clear = expected > VALVE_PRESSURE_PA
+    if clear.sum() < MIN_SAMPLES:
+        return
+    ratio = float(np.median(run.pressure_pa[clear]) / np.median(expected[clear]))
+    if not PLAUSIBLE_RATIO[0] <= ratio <= PLAUSIBLE_RATIO[1]:
+        _refuse(run, "brake_pressure_bar", ratio, "what the valve map gives for its current",
+                _likely(ratio, "pressure", "bar"))

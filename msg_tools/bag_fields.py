@@ -1,0 +1,123 @@
+"""Which topic and message field carries each contract quantity in a bag, and reading it.
+
+The contract topics (:mod:`msg_tools.contract`) are used where present. Otherwise a topic
+is found by its tail: ``/brake/pressure`` matches ``/rig2/brake/pressure`` or
+``/brake/pressure`` (one match only), and ``joint_state`` also matches ``joint_states``. A
+column-mapping file may name ``topic`` and ``field`` (``data``, ``fluid_pressure``,
+``velocity[0]``, ``velocity[wheel]`` — a JointState entry by joint name —, ``position[0]``,
+``wrench.force.x``). A JointState without velocities gives its positions, which the reader
+differentiates.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Any
+
+from .contract import (
+    ATMOSPHERE_PA,
+    TOPIC_CURRENT,
+    TOPIC_FLYWHEEL,
+    TOPIC_PRESSURE,
+    TOPIC_WHEEL,
+    TOPIC_WRENCH,
+)
+from .errors import RunFormatError
+from .mapping import Channel
+
+CONTRACT_SOURCES: dict[str, tuple[str, str]] = {
+    "current_ref_A": (TOPIC_CURRENT, "data"),
+    "brake_pressure_bar": (TOPIC_PRESSURE, "fluid_pressure"),
+    "wheel_speed_rad_s": (TOPIC_WHEEL, "velocity[wheel]"),
+    "flywheel_speed_rad_s": (TOPIC_FLYWHEEL, "velocity[flywheel]"),
+    "vertical_load_N": (TOPIC_WRENCH, "wrench.force.z"),
+    "longitudinal_force_N": (TOPIC_WRENCH, "wrench.force.x"),
+}
+"""Contract column → (contract topic, field)."""
+
+_STEP = re.compile(r"(\w+)(?:\[(\w+)\])?")
+
+
+@dataclass(frozen=True)
+class FieldPath:
+    """A field such as ``wrench.force.x`` or ``velocity[wheel]`` (index or joint name)."""
+
+    text: str
+
+    @cached_property
+    def steps(self) -> list[tuple[str, str]]:
+        steps = _STEP.findall(self.text)
+        if not steps:
+            raise RunFormatError(f"field {self.text!r}: expected e.g. wrench.force.x or "
+                                 "velocity[0]")
+        return steps
+
+    def read(self, message: Any) -> tuple[float, bool]:
+        """(value, whether it is a JointState position standing in for a velocity)."""
+        value: Any = message
+        position = False
+        for name, index in self.steps:
+            if name == "velocity" and index and _positions_only(message):
+                name, position = "position", True
+            value = getattr(value, name)
+            if index:
+                value = value[_index(message, index)]
+        if name == "position":
+            position = True
+        if name == "fluid_pressure":
+            value = value - ATMOSPHERE_PA  # FluidPressure is absolute; the contract is gauge
+        return float(value), position
+
+
+def _positions_only(message: Any) -> bool:
+    """A JointState that carries positions and no velocities."""
+    return hasattr(message, "position") and len(message.velocity) == 0 and len(
+        message.position) > 0
+
+
+def _index(message: Any, index: str) -> int:
+    if index.isdigit():
+        return int(index)
+    names = list(getattr(message, "name", []))
+    return names.index(index) if index in names else 0
+
+
+@dataclass(frozen=True)
+class Source:
+    """Where one contract column is read from in a bag."""
+
+    contract: str
+    topic: str
+    field: FieldPath
+    channel: Channel
+
+
+def resolve(mapping: dict[str, Channel], topics: Sequence[str], where: str) -> list[Source]:
+    """The bag source of each contract column except time (the wheel's stamps)."""
+    sources = []
+    for contract, (default_topic, default_field) in CONTRACT_SOURCES.items():
+        channel = mapping[contract]
+        topic = channel.topic or _find_topic(default_topic, topics, contract, where)
+        if topic not in topics:
+            raise RunFormatError(f"{where}: bag has no topic {topic} (for {contract}; topics: "
+                                 f"{', '.join(topics)})")
+        sources.append(Source(contract, topic, FieldPath(channel.field or default_field),
+                              channel))
+    return sources
+
+
+def _find_topic(contract_topic: str, topics: Sequence[str], contract: str, where: str) -> str:
+    if contract_topic in topics:
+        return contract_topic
+    tail = contract_topic.removeprefix("/rig")
+    tails = {tail, tail + "s"} if tail.endswith("joint_state") else {tail}
+    found = [t for t in topics if any(t.endswith(x) for x in tails)]
+    if len(found) == 1:
+        return found[0]
+    hint = f"topics {', '.join(found)} all match" if found else "no topic matches"
+    raise RunFormatError(f"{where}: bag has no messages on {contract_topic} for {contract} "
+                         f"({hint}); name the topic in a column-mapping file "
+                         f"({contract}: {{topic: /your/topic}})")

@@ -1,0 +1,120 @@
+"""Read a run from a ROS bag: rosbag2 (folder, or bare ``.mcap``/``.db3`` files) or ROS 1.
+
+Messages are streamed: each is reduced to its stamp and the numbers the run needs as it is
+read (``array('d')``), so memory grows with the samples kept, not with the messages
+decoded. Stamped topics are matched to the wheel encoder's stamps by linear interpolation,
+the current command by log time (held, as the valve sees it).
+"""
+
+from __future__ import annotations
+
+from array import array
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from rosbags.highlevel import AnyReader
+
+from .bag_fields import Source, resolve
+from .bag_io import TYPESTORE
+from .checks import check_plausible
+from .contract import CSV_TO_FIELD
+from .derivative import speed_from_angle
+from .errors import RunFormatError
+from .mapping import DEFAULT_MAPPING, Mapping
+from .run import Run
+
+STORAGE_SUFFIXES = (".mcap", ".db3")
+
+
+def bag_paths(path: Path) -> list[Path]:
+    """What to open for ``path``: the bag folder, a ROS 1 ``.bag``, a storage file, or the
+    storage files of a folder that lost its ``metadata.yaml``."""
+    if path.is_dir() and not (path / "metadata.yaml").exists():
+        files = sorted(p for p in path.iterdir() if p.suffix.lower() in STORAGE_SUFFIXES)
+        if not files:
+            raise RunFormatError(f"{path}: not a bag (no metadata.yaml, no .mcap/.db3 file)")
+        return files
+    return [path]
+
+
+@dataclass
+class _Series:
+    """Stamps and values of one contract column as they stream in."""
+
+    time_s: array = field(default_factory=lambda: array("d"))
+    values: array = field(default_factory=lambda: array("d"))
+    positions: bool = False
+
+
+def read_bag(path: Path, name: str | None = None, mapping: Mapping | None = None) -> Run:
+    """The run in the bag at ``path`` (SI, checked), on the wheel encoder's time base."""
+    path = Path(path)
+    where = str(path)
+    try:
+        with AnyReader(bag_paths(path), default_typestore=TYPESTORE) as reader:
+            topics = sorted({c.topic for c in reader.connections})
+            sources = resolve(mapping or DEFAULT_MAPPING, topics, where)
+            series = _stream(reader, sources)
+    except RunFormatError:
+        raise
+    except Exception as exc:  # rosbags raises several types for damaged bags
+        raise RunFormatError(f"{where}: cannot read bag ({exc})") from None
+    fields = _on_wheel_base(series, sources, where)
+    check_plausible(fields, where)
+    return Run(name=name or path.stem, source=where, **fields)
+
+
+def _stream(reader: AnyReader, sources: list[Source]) -> dict[str, _Series]:
+    series = {s.contract: _Series() for s in sources}
+    by_topic: dict[str, list[Source]] = {}
+    for source in sources:
+        by_topic.setdefault(source.topic, []).append(source)
+    wanted = [c for c in reader.connections if c.topic in by_topic]
+    for connection, log_time, raw in reader.messages(connections=wanted):
+        message = reader.deserialize(raw, connection.msgtype)
+        for source in by_topic[connection.topic]:
+            stamp = _stamp_s(message, log_time, stamped=source.contract != "current_ref_A")
+            try:
+                value, position = source.field.read(message)
+            except (AttributeError, IndexError, TypeError) as exc:
+                raise RunFormatError(f"{connection.topic} has no field {source.field.text} "
+                                     f"({type(exc).__name__}: {exc})") from None
+            target = series[source.contract]
+            target.time_s.append(stamp)
+            target.values.append(value)
+            target.positions |= position
+    return series
+
+
+def _stamp_s(message: Any, log_time_ns: int, stamped: bool) -> float:
+    header = getattr(message, "header", None)
+    if stamped and header is not None and (header.stamp.sec or header.stamp.nanosec):
+        return header.stamp.sec + header.stamp.nanosec * 1e-9
+    return log_time_ns * 1e-9
+
+
+def _on_wheel_base(series: dict[str, _Series], sources: list[Source], where: str
+                   ) -> dict[str, np.ndarray]:
+    empty = [s.topic for s in sources if not series[s.contract].time_s]
+    if empty:
+        raise RunFormatError(f"{where}: bag has no messages on {', '.join(dict.fromkeys(empty))}")
+    base = np.asarray(series["wheel_speed_rad_s"].time_s)
+    fields = {"time_s": base}
+    for source in sources:
+        fields[CSV_TO_FIELD[source.contract]] = _column(series[source.contract], source, base)
+    return fields
+
+
+def _column(series: _Series, source: Source, base: np.ndarray) -> np.ndarray:
+    times = np.asarray(series.time_s)
+    channel = source.channel
+    values = channel.to_si(np.asarray(series.values),
+                           None if channel.unit_declared else 1.0)  # messages carry SI
+    if series.positions:
+        values = speed_from_angle(times, values)
+    if source.contract == "current_ref_A":
+        held = np.searchsorted(times, base + 1e-9, side="right") - 1
+        return values[np.clip(held, 0, None)]
+    return np.interp(base, times, values)

@@ -1,0 +1,144 @@
+"""Tables in the binary formats rigs and their tools write: MATLAB, HDF5, Parquet, MDF4, TDMS.
+
+Each reader returns a :class:`~msg_tools.text_table.Table` of every 1-D numeric (or
+datetime) column of one length, by name; MDF4 and TDMS also give their units. MATLAB v5
+files need only scipy; the others use a well-kept library from the optional extra
+``landing_gear_sim[formats]`` (h5py, pyarrow, asammdf, npTDMS), imported only when such a
+file is read, with a one-line hint when it is missing.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+
+from .errors import RunFormatError
+from .text_table import MASTER_TIME, Table
+
+INSTALL_HINT = "pip install 'landing_gear_sim[formats]'"
+
+
+def _library(name: str, path: Path) -> ModuleType:
+    try:
+        return importlib.import_module(name)
+    except ImportError:
+        raise RunFormatError(f"{path}: reading {path.suffix} files needs {name.split('.')[0]}:"
+                             f" {INSTALL_HINT}") from None
+
+
+def _same_length(named: Iterable[tuple[str, Any]]) -> dict[str, np.ndarray]:
+    """The 1-D numeric or datetime arrays among ``named``, of the most common length."""
+    arrays = {}
+    for name, value in named:
+        array = np.asarray(value).squeeze()
+        if array.ndim == 1 and array.size >= 2 and array.dtype.kind in "fiuM":
+            arrays[name] = array
+    if not arrays:
+        return {}
+    lengths = [a.size for a in arrays.values()]
+    common = max(set(lengths), key=lengths.count)
+    return {n: a for n, a in arrays.items() if a.size == common}
+
+
+def read_mat(path: Path) -> Table:
+    """MATLAB: v5 through scipy; v7.3 (HDF5 inside) through h5py. Top-level vectors and
+    the vector fields of top-level structs (as ``struct.field`` and ``field``)."""
+    import scipy.io
+
+    try:
+        content = scipy.io.loadmat(path, squeeze_me=True, struct_as_record=False)
+    except NotImplementedError:  # v7.3
+        return read_hdf5(path)
+    except Exception as exc:  # scipy raises many types for damaged files
+        raise RunFormatError(f"{path}: cannot read MATLAB file ({exc or type(exc).__name__})"
+                             ) from None
+    named: list[tuple[str, Any]] = []
+    for name, value in content.items():
+        if name.startswith("__"):
+            continue
+        fields = getattr(value, "_fieldnames", None)
+        if fields:
+            named += [(f, getattr(value, f)) for f in fields]
+            named += [(f"{name}.{f}", getattr(value, f)) for f in fields]
+        else:
+            named.append((name, value))
+    return Table(_same_length(named), {})
+
+
+def read_hdf5(path: Path) -> Table:
+    """HDF5 (and MATLAB v7.3): every 1-D dataset, by its path and by its last name."""
+    h5py = _library("h5py", path)
+    named: list[tuple[str, Any]] = []
+
+    def visit(name: str, node: Any) -> None:
+        if isinstance(node, h5py.Dataset) and node.ndim <= 2 and min(node.shape or (0,)) >= 1:
+            named.append((name, node[()]))
+            named.append((name.rsplit("/", 1)[-1], named[-1][1]))
+
+    try:
+        with h5py.File(path, "r") as file:
+            file.visititems(visit)
+    except OSError as exc:
+        raise RunFormatError(f"{path}: cannot read HDF5 file ({exc})") from None
+    return Table(_same_length(named), {})
+
+
+def read_parquet(path: Path) -> Table:
+    parquet = _library("pyarrow.parquet", path)
+    try:
+        table = parquet.read_table(path)
+    except Exception as exc:  # pyarrow raises its own error types
+        raise RunFormatError(f"{path}: cannot read Parquet file ({exc})") from None
+    return Table(_same_length((n, table.column(n).to_numpy()) for n in table.column_names), {})
+
+
+def read_mdf(path: Path) -> Table:
+    """MDF 3/4: every channel on the time base of the first group's master channel,
+    (channels of other rates are interpolated onto it)."""
+    asammdf = _library("asammdf", path)
+    try:
+        with asammdf.MDF(path) as mdf:
+            names = [n for n in mdf.channels_db if n not in ("t", "time")]
+            signals = mdf.select(names, raw=False)
+    except Exception as exc:  # asammdf raises many types for damaged files
+        raise RunFormatError(f"{path}: cannot read MDF file ({exc})") from None
+    if not signals:
+        raise RunFormatError(f"{path}: the MDF file holds no channel")
+    base = signals[0].timestamps
+    named = [(MASTER_TIME, base)] + [(s.name, s.interp(base).samples) for s in signals]
+    units = {s.name: s.unit for s in signals if s.unit}
+    return Table(_same_length(named), {MASTER_TIME: "s", **units})
+
+
+def read_tdms(path: Path) -> Table:
+    """TDMS: every channel by name and ``group/name``; the time from the waveform
+    properties of the first channel, used when no channel holds it."""
+    nptdms = _library("nptdms", path)
+    try:
+        channels = [c for g in nptdms.TdmsFile.read(path).groups() for c in g.channels()]
+    except Exception as exc:  # npTDMS raises many types for damaged files
+        raise RunFormatError(f"{path}: cannot read TDMS file ({exc})") from None
+    named: list[tuple[str, Any]] = []
+    units = {}
+    for channel in channels:
+        data = channel[:]
+        named += [(channel.name, data), (f"{channel.group_name}/{channel.name}", data)]
+        if "unit_string" in channel.properties:
+            units[channel.name] = str(channel.properties["unit_string"])
+    if channels and "wf_increment" in channels[0].properties:
+        named.append((MASTER_TIME, channels[0].time_track()))
+        units[MASTER_TIME] = "s"
+    return Table(_same_length(named), units)
+
+
+READERS: dict[str, Callable[[Path], Table]] = {
+    ".mat": read_mat, ".h5": read_hdf5, ".hdf5": read_hdf5, ".hdf": read_hdf5,
+    ".parquet": read_parquet, ".pq": read_parquet, ".mf4": read_mdf, ".mdf": read_mdf,
+    ".tdms": read_tdms,
+}
+"""Lower-case file suffix → reader."""

@@ -1,0 +1,94 @@
+"""From a table's named columns to a :class:`~msg_tools.run.Run`: mapping, units, time, checks."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from .checks import check_plausible
+from .contract import CSV_COLUMNS, CSV_TO_FIELD
+from .errors import RunFormatError
+from .mapping import DATETIME, DEFAULT_MAPPING, Channel, Mapping
+from .run import Run
+from .text_table import MASTER_TIME, Table
+from .units import QUANTITY, UNITS, parse_unit
+
+
+def wanted_columns(mapping: Mapping) -> list[str]:
+    return [mapping[c].column for c in CSV_COLUMNS]
+
+
+def text_columns(mapping: Mapping) -> list[str]:
+    """Columns read as text: time, which may be numbers or calendar date-times."""
+    return [mapping["time_s"].column]
+
+
+def run_from_table(table: Table, where: str, name: str, mapping: Mapping | None = None
+                   ) -> Run:
+    """The run in ``table`` (SI, checked); the message of any error names ``where``."""
+    mapping = mapping or DEFAULT_MAPPING
+    fields: dict[str, np.ndarray] = {}
+    for contract in CSV_COLUMNS:
+        channel = _with_written_unit(_master_time(mapping[contract], contract, table),
+                                     contract, table, where)
+        if channel.column not in table.columns:
+            found = ", ".join(table.columns) or "none"
+            raise RunFormatError(f"{where}: missing column {channel.column} for {contract} "
+                                 f"(found {found}); name it in a column-mapping file")
+        fields[CSV_TO_FIELD[contract]] = _to_si(channel, table.columns[channel.column], where)
+    check_plausible(fields, where)
+    return Run(name=name, source=where, **fields)
+
+
+def _master_time(channel: Channel, contract: str, table: Table) -> Channel:
+    if contract == "time_s" and channel.column not in table.columns and \
+            MASTER_TIME in table.columns:
+        return replace(channel, column=MASTER_TIME)
+    return channel
+
+
+def _with_written_unit(channel: Channel, contract: str, table: Table, where: str) -> Channel:
+    """``channel`` in the unit the file itself states (units row, header cell, MDF/TDMS
+    metadata), unless the mapping file declared another one: then that is an error."""
+    written = table.units.get(channel.column)
+    if written is None or channel.unit == DATETIME:
+        return channel
+    quantity = QUANTITY[CSV_TO_FIELD[contract]]
+    unit = parse_unit(written, quantity)
+    if unit is None:
+        raise RunFormatError(f"{where}: column {channel.column} has the unit {written!r}, "
+                             f"not one of {', '.join(UNITS[quantity])} for {contract}")
+    if unit == channel.unit:
+        return channel
+    if channel.unit_declared:
+        raise RunFormatError(f"{where}: column {channel.column} says its unit is {written!r} "
+                             f"but the column mapping declares {channel.unit!r}")
+    return channel.with_unit(unit, UNITS[quantity][unit])
+
+
+def _to_si(channel: Channel, raw: np.ndarray, where: str) -> np.ndarray:
+    if raw.dtype.kind in "USO":
+        raw = np.char.replace(np.char.strip(raw.astype(str), '"'), ",", ".")
+        try:
+            raw = raw.astype(float)
+        except ValueError:
+            return _calendar_seconds(channel, raw, where)
+    if raw.dtype.kind == "M":
+        return _calendar_seconds(channel, raw, where)
+    values = channel.to_si(raw)
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        raise RunFormatError(f"{where}: column {channel.column} has NaN/inf at data row "
+                             f"{bad[0] + 1}")
+    return values
+
+
+def _calendar_seconds(channel: Channel, raw: np.ndarray, where: str) -> np.ndarray:
+    """Seconds since the epoch of a datetime column (µs resolution)."""
+    try:
+        stamps = raw.astype("datetime64[us]")
+    except ValueError:
+        raise RunFormatError(f"{where}: column {channel.column} holds neither numbers nor "
+                             f"ISO 8601 date-times (first value {raw[0]!r})") from None
+    return stamps.astype(np.int64) * 1e-6

@@ -1,0 +1,211 @@
+"""Delimited text as rig loggers write it, read into named columns.
+
+Recognised without configuration: the encoding (UTF-8 with or without BOM, UTF-16 with a
+BOM, else Latin-1), the separator (``,`` ``;`` tab ``|`` or blanks), a decimal comma, a
+metadata preamble above the header, a units row below it or units in the header cells
+(``p_brake [bar]``), quoted cells, text columns (read only when asked for) and a footer.
+The data block is the longest run of lines that split into the same number of cells,
+at least two of them numbers; the header is the last line above it naming the wanted
+columns.
+"""
+
+from __future__ import annotations
+
+import codecs
+import csv
+import gzip
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .errors import RunFormatError
+
+SEPARATORS = (",", ";", "\t", "|", " ")
+SAMPLE_LINES = 40  # lines of the data block used to decide its separator
+_UNIT_IN_HEADER = re.compile(r"^(.*?)\s*[\[(]([^\])]*)[\])]\s*$")
+_DECIMAL_COMMA = re.compile(r"^[+-]?\d*,\d+([eE][+-]?\d+)?$")
+
+
+MASTER_TIME = "<master time>"
+"""The column of a format's own time base (MDF master channel, TDMS waveform timing),
+used for time when the mapped time column is absent."""
+
+
+@dataclass(frozen=True)
+class Table:
+    """Columns of one table by name (raw numbers, or text for text columns) and the units
+    its header or units row gave (by column; absent where none was written)."""
+
+    columns: dict[str, np.ndarray]
+    units: dict[str, str]
+
+
+def read_text(path: Path) -> str:
+    """The text of ``path`` (gzip-compressed if it ends in ``.gz``), encoding detected."""
+    try:
+        raw = Path(path).read_bytes()
+        if path.suffix.lower() == ".gz":
+            raw = gzip.decompress(raw)
+    except (OSError, EOFError) as exc:
+        raise RunFormatError(f"{path}: cannot read ({getattr(exc, 'strerror', None) or exc})"
+                             ) from None
+    return decode(raw)
+
+
+def decode(raw: bytes) -> str:
+    """Text of ``raw``: a BOM decides, else UTF-8, else Latin-1 (which never fails)."""
+    if raw.startswith(codecs.BOM_UTF8):
+        return raw[len(codecs.BOM_UTF8):].decode("utf-8", errors="replace")
+    if raw.startswith((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)):
+        return raw.decode("utf-16", errors="replace")
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError:
+        return raw.decode("latin-1")
+
+
+@dataclass(frozen=True)
+class Dialect:
+    separator: str
+    decimal: str
+    cells: int  # per line of the data block
+
+
+def read_table(text: str, wanted: Sequence[str], where: str,
+               text_columns: Sequence[str] = ()) -> Table:
+    """The ``wanted`` columns of ``text`` (numbers; ``text_columns`` as text)."""
+    lines = text.splitlines()
+    dialect = sniff(lines, where)
+    first, last = data_block(lines, dialect)
+    header_at, names = find_header(lines[:first], dialect, wanted, where)
+    units = {**_header_units(lines[header_at], dialect, names)}
+    for row in lines[header_at + 1:first]:
+        cells = split(row, dialect.separator)
+        if len(cells) == len(names):
+            units.update({n: c.strip() for n, c in zip(names, cells, strict=True) if c.strip()})
+    body = lines[first:last]
+    columns = {name: _column(body, dialect, names.index(name), name in text_columns,
+                             f"{where}: column {name}", first) for name in wanted}
+    return Table(columns, units)
+
+
+def split(line: str, separator: str) -> list[str]:
+    if separator == " ":
+        return line.split()
+    return next(csv.reader([line], delimiter=separator))
+
+
+def sniff(lines: list[str], where: str) -> Dialect:
+    """Separator and decimal mark from the file's last lines (the data, not the preamble)."""
+    sample = [line for line in lines[-SAMPLE_LINES - 5:] if line.strip()][-SAMPLE_LINES:]
+    if not sample:
+        raise RunFormatError(f"{where}: the file is empty")
+    if len(sample) == 1:
+        raise RunFormatError(f"{where}: no data rows (the file has one line: "
+                             f"{sample[0][:60]!r})")
+    best: tuple[int, Dialect] | None = None
+    for separator in SEPARATORS:
+        rows = [split(line, separator) for line in sample]
+        counts = {len(r) for r in rows}
+        if len(counts) != 1 or counts == {1}:
+            continue
+        decimal = "," if separator != "," and _uses_decimal_comma(rows) else "."
+        numeric = sum(all(_is_number(r[k], decimal) for r in rows) for k in range(len(rows[0])))
+        if numeric >= 2 and (best is None or numeric > best[0]):
+            best = (numeric, Dialect(separator, decimal, len(rows[0])))
+    if best is None:
+        raise RunFormatError(f"{where}: no table of numbers found (separator , ; tab | or "
+                             "blanks; is this a text table?)")
+    return best[1]
+
+
+def _uses_decimal_comma(rows: list[list[str]]) -> bool:
+    return any(_DECIMAL_COMMA.match(cell.strip()) for row in rows for cell in row)
+
+
+def _is_number(cell: str, decimal: str) -> bool:
+    try:
+        float(cell.strip().replace(decimal, ".") if decimal == "," else cell)
+    except ValueError:
+        return False
+    return True
+
+
+def _is_data(line: str, dialect: Dialect) -> bool:
+    cells = split(line, dialect.separator) if line.strip() else []
+    return len(cells) == dialect.cells and sum(
+        _is_number(c, dialect.decimal) for c in cells) >= 2
+
+
+def data_block(lines: list[str], dialect: Dialect) -> tuple[int, int]:
+    """[first, last) lines of the data: after the header and units rows, before a footer."""
+    last = len(lines)
+    while last > 0 and not _is_data(lines[last - 1], dialect):
+        last -= 1
+    first = 0
+    while first < last and not (_is_data(lines[first], dialect)
+                                and _is_data(lines[min(first + 1, last - 1)], dialect)):
+        first += 1
+    return first, last
+
+
+def find_header(above: list[str], dialect: Dialect, wanted: Sequence[str], where: str
+                ) -> tuple[int, list[str]]:
+    """Index and cell names of the header: the last line above the data naming ``wanted``."""
+    candidates = []
+    for index in range(len(above) - 1, -1, -1):
+        cells = split(above[index], dialect.separator)
+        if len(cells) != dialect.cells:
+            continue
+        names = [_name(cell) for cell in cells]
+        candidates.append((index, names))
+        if all(w in names for w in wanted):
+            return index, names
+        folded = [n.lower() for n in names]
+        if all(w.lower() in folded for w in wanted):
+            return index, [_original(n, wanted) for n in names]
+    found = candidates[-1][1] if candidates else []
+    missing = [w for w in wanted if w not in found]
+    if not candidates:
+        raise RunFormatError(f"{where}: no header row above the numbers (expected the "
+                             f"columns {', '.join(wanted)})")
+    raise RunFormatError(f"{where}: missing column(s) {', '.join(missing)} "
+                         f"(found {', '.join(found)}); name them in a column-mapping file")
+
+
+def _name(cell: str) -> str:
+    match = _UNIT_IN_HEADER.match(cell.strip())
+    return (match.group(1) if match else cell).strip().strip('"')
+
+
+def _original(name: str, wanted: Sequence[str]) -> str:
+    return next((w for w in wanted if w.lower() == name.lower()), name)
+
+
+def _header_units(line: str, dialect: Dialect, names: list[str]) -> dict[str, str]:
+    units = {}
+    for name, cell in zip(names, split(line, dialect.separator), strict=True):
+        match = _UNIT_IN_HEADER.match(cell.strip())
+        if match:
+            units[name] = match.group(2).strip()
+    return units
+
+
+def _column(body: list[str], dialect: Dialect, index: int, as_text: bool, where: str,
+            offset: int) -> np.ndarray:
+    separator = None if dialect.separator == " " else dialect.separator
+    rows = body if dialect.decimal == "." or as_text else [
+        line.replace(",", ".") for line in body]
+    try:
+        return np.loadtxt(rows, delimiter=separator, usecols=[index], quotechar='"',
+                          dtype=str if as_text else float, ndmin=1)
+    except ValueError as exc:
+        found = re.search(r"string '(.*)' to float64 at row (\d+)", str(exc))
+        if not found:
+            raise RunFormatError(f"{where}: unreadable values ({exc})") from None
+        line = int(found.group(2)) + offset + 1
+        raise RunFormatError(f"{where}: unreadable value {found.group(1)!r} at line {line}"
+                             ) from None

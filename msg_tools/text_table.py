@@ -87,8 +87,12 @@ def read_table(text: str, wanted: Sequence[str], where: str,
         if len(cells) == len(names):
             units.update({n: c.strip() for n, c in zip(names, cells, strict=True) if c.strip()})
     body = lines[first:last]
-    columns = {name: _column(body, dialect, names.index(name), name in text_columns,
-                             f"{where}: column {name}", first) for name in wanted}
+    numeric = [n for n in wanted if n not in text_columns]
+    columns = dict(zip(numeric, _numbers(body, dialect, names, numeric, where, first),
+                       strict=True))
+    for name in wanted:
+        if name in text_columns:
+            columns[name] = _text(body, dialect, names.index(name))
     return Table(columns, units)
 
 
@@ -194,18 +198,28 @@ def _header_units(line: str, dialect: Dialect, names: list[str]) -> dict[str, st
     return units
 
 
-def _column(body: list[str], dialect: Dialect, index: int, as_text: bool, where: str,
-            offset: int) -> np.ndarray:
-    separator = None if dialect.separator == " " else dialect.separator
-    rows = body if dialect.decimal == "." or as_text else [
-        line.replace(",", ".") for line in body]
+def _delimiter(dialect: Dialect) -> str | None:
+    return None if dialect.separator == " " else dialect.separator
+
+
+def _numbers(body: list[str], dialect: Dialect, names: list[str], wanted: list[str],
+             where: str, offset: int) -> list[np.ndarray]:
+    """The ``wanted`` numeric columns, parsed in one pass over the data lines."""
+    rows = body if dialect.decimal == "." else [line.replace(",", ".") for line in body]
     try:
-        return np.loadtxt(rows, delimiter=separator, usecols=[index], quotechar='"',
-                          dtype=str if as_text else float, ndmin=1)
+        table = np.loadtxt(rows, delimiter=_delimiter(dialect), quotechar='"', ndmin=2,
+                           usecols=[names.index(n) for n in wanted])
     except ValueError as exc:
-        found = re.search(r"string '(.*)' to float64 at row (\d+)", str(exc))
+        found = re.search(r"string '(.*)' to float64 at row (\d+), column (\d+)", str(exc))
         if not found:
             raise RunFormatError(f"{where}: unreadable values ({exc})") from None
         line = int(found.group(2)) + offset + 1
-        raise RunFormatError(f"{where}: unreadable value {found.group(1)!r} at line {line}"
-                             ) from None
+        column = names[int(found.group(3)) - 1]
+        raise RunFormatError(f"{where}: column {column}: unreadable value "
+                             f"{found.group(1)!r} at line {line}") from None
+    return list(table.T)
+
+
+def _text(body: list[str], dialect: Dialect, index: int) -> np.ndarray:
+    return np.loadtxt(body, delimiter=_delimiter(dialect), usecols=[index], quotechar='"',
+                      dtype=str, ndmin=1)

@@ -17,13 +17,11 @@ from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model.actuator import actuator_pressure
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s, rolling_radius_at
+from msg_tools.checks import CONTACT_LOAD_N, MIN_BRAKING_SAMPLES, TURNING_RAD_S
 from msg_tools.units import PA_PER_BAR, UNITS
 
 PLAUSIBLE_RATIO = (0.5, 2.0)  # measured/expected: other rigs differ, not by a unit factor
 MATCH = 0.15  # a ratio within 15 % of a unit factor is taken for that unit
-MIN_SAMPLES = 50
-LOADED_N = 2e3
-TURNING_RAD_S = 1.0
 VALVE_PRESSURE_PA = 5 * PA_PER_BAR  # compare where the valve map is clear of its dead-band
 
 
@@ -51,9 +49,9 @@ def _refuse(run: ClassifiedRun, column: str, ratio: float, what: str, unit: str 
 
 
 def _check_speeds(run: ClassifiedRun, params: RigParameters) -> None:
-    rolling = ((run.time_s < run.brake_start_s) & (run.vertical_load_n > LOADED_N)
+    rolling = ((run.time_s < run.brake_start_s) & (run.vertical_load_n > CONTACT_LOAD_N)
                & (np.abs(run.flywheel_speed_rad_s) > TURNING_RAD_S))
-    if not run.braking or rolling.sum() < MIN_SAMPLES:
+    if not run.braking or rolling.sum() < MIN_BRAKING_SAMPLES:
         return
     wheel = run.wheel_speed_rad_s[rolling] * rolling_radius_at(params, run.vertical_load_n[rolling])
     ratio = float(np.median(wheel) / np.median(rim_speed_m_s(params, run.flywheel_speed_rad_s[
@@ -72,7 +70,7 @@ def _check_speeds(run: ClassifiedRun, params: RigParameters) -> None:
 def _check_pressure(run: ClassifiedRun, params: RigParameters) -> None:
     expected = actuator_pressure(params, run.current_a, run.rate_hz)
     clear = expected > VALVE_PRESSURE_PA
-    if clear.sum() < MIN_SAMPLES:
+    if clear.sum() < MIN_BRAKING_SAMPLES:
         return
     ratio = float(np.median(run.pressure_pa[clear]) / np.median(expected[clear]))
     if not PLAUSIBLE_RATIO[0] <= ratio <= PLAUSIBLE_RATIO[1]:

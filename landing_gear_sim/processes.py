@@ -1,4 +1,5 @@
-"""Child processes that never outlive their parent (Linux). Imports nothing of the project:
+"""Child processes that never outlive their parent (Linux), and worker-pool processes that
+leave signals to their parent. Imports nothing of the project:
 the graph launcher and the diagnosis' worker pool both use it."""
 
 from __future__ import annotations
@@ -14,3 +15,12 @@ def die_with_parent() -> None:
     or a killed `diagnose` leaves no orphan running on)."""
     libc = ctypes.CDLL(None, use_errno=True)
     libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
+
+
+def pool_worker() -> None:
+    """Initializer of a worker-pool process: dies with its parent, leaves Ctrl-C to it (the
+    parent stops the pool), and ends on SIGTERM at once (without the parent's handlers,
+    which a forked child inherits and which would print a traceback)."""
+    die_with_parent()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)

@@ -15,6 +15,7 @@ from .csv_io import read_csv, run_name
 from .errors import RunFormatError
 from .mapping import Mapping
 from .run import Run
+from .timebase import split_at_gaps
 
 TEXT_SUFFIXES = (".csv", ".txt", ".tsv", ".dat", ".asc")
 NOT_RUNS = (".yaml", ".yml", ".json", ".md", ".rst", ".html", ".png", ".svg", ".pdf", ".log",
@@ -100,17 +101,22 @@ def campaign_sources(folder: Path) -> list[Path]:
 
 def read_campaign(folder: Path, mapping: Mapping | None = None,
                   progress: Callable[[str], None] | None = None) -> Campaign:
-    """Read every run of ``folder``; a bad file is reported and skipped, not fatal."""
+    """Read every run of ``folder``; a bad file is reported and skipped, not fatal. A run
+    with long gaps becomes its parts (:func:`~msg_tools.timebase.split_at_gaps`)."""
     folder = Path(folder)
-    runs, problems = [], []
+    runs: list[Run] = []
+    problems: list[str] = []
     sources = campaign_sources(folder)
     for number, source in enumerate(sources, 1):
         if progress and len(sources) > 1:
             progress(f"reading {number}/{len(sources)}: {source.relative_to(folder)}")
         try:
-            runs.append(read_run(source, mapping, _campaign_name(folder, source)))
+            split = split_at_gaps(read_run(source, mapping, _campaign_name(folder, source)))
         except RunFormatError as exc:
             problems.append(str(exc))
+            continue
+        runs.extend(split.parts)
+        problems.extend(split.notes)
     if not runs:
         raise RunFormatError(f"{folder}: no readable run" +
                              (f" ({'; '.join(problems)})" if problems else ""))
@@ -127,7 +133,8 @@ def read_runs(paths: Sequence[Path], mapping: Mapping | None = None) -> Campaign
     """Runs from files, bags and campaign folders, in the order given.
 
     A bad file inside a folder is reported and skipped; a bad file named explicitly
-    is an error (the user asked for it). Two runs with the same name are an error.
+    is an error (the user asked for it). Two runs with the same name are an error. A
+    run with long gaps becomes its parts.
     """
     runs: list[Run] = []
     problems: list[str] = []
@@ -137,7 +144,9 @@ def read_runs(paths: Sequence[Path], mapping: Mapping | None = None) -> Campaign
             runs.extend(campaign.runs)
             problems.extend(campaign.problems)
         else:
-            runs.append(read_run(path, mapping))
+            split = split_at_gaps(read_run(path, mapping))
+            runs.extend(split.parts)
+            problems.extend(split.notes)
     names = [r.name for r in runs]
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:

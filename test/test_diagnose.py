@@ -6,6 +6,10 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import signal
+import subprocess
+import sys
+import time
 
 import numpy as np
 import pytest
@@ -200,3 +204,114 @@ def test_cli_writes_the_contract_json_and_the_report(reference, tmp_path, capsys
 def test_cli_diagnose_on_a_missing_folder_is_one_error_line(capsys):
     assert main(["diagnose", "/nonexistent/campaign"]) == 2
     assert capsys.readouterr().err.count("\n") == 1
+
+
+def _children(pid):
+    with open(f"/proc/{pid}/task/{pid}/children") as listing:
+        return [int(c) for c in listing.read().split()]
+
+
+def _alive(pid):
+    try:
+        with open(f"/proc/{pid}/stat") as stat:
+            return stat.read().split(")")[-1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+@pytest.mark.parametrize(("signum", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_a_signal_to_diagnose_ends_its_workers_and_writes_nothing(reference, tmp_path, signum,
+                                                                  code):
+    """SIGTERM to the main `diagnose` once left its 2 workers orphaned for minutes; SIGINT
+    to it alone would wait for their fits. Both now end the workers at once."""
+    folder = tmp_path / "campaign"
+    _campaign(reference, folder, 110)
+    out = tmp_path / "extended.yaml"
+    process = subprocess.Popen([sys.executable, "-m", "landing_gear_sim", "diagnose", str(folder),
+                                "-o", str(out)], stderr=subprocess.PIPE, text=True)
+    lines = []
+    for line in process.stderr:
+        lines.append(line)
+        if "round 1: fitting" in line:
+            break
+    time.sleep(2.0)  # the workers are fitting
+    workers = _children(process.pid)
+    assert len(workers) >= 2, "".join(lines)
+    process.send_signal(signum)
+    rest = process.communicate(timeout=20)[1]
+    assert process.returncode == code, rest
+    assert "Traceback" not in rest
+    deadline = time.monotonic() + 5
+    while any(_alive(w) for w in workers) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not any(_alive(w) for w in workers)
+    assert not out.exists()
+
+
+@pytest.fixture(scope="module")
+def delay_campaign(reference, tmp_path_factory):
+    """A rig with an 8 ms valve delay; the cases below hand diagnose parts of its campaign."""
+    folder = tmp_path_factory.mktemp("delay_campaign")
+    runs, rig = _campaign(reference, folder, 120, lambda rng: {
+        "elements.actuator_delay": True, "actuator.delay_s": 0.008})
+    return {r.name: r for r in runs}, rig
+
+
+def _notes(result):
+    return "\n".join(result.problems)
+
+
+def test_one_braking_run_is_inconclusive_not_none(reference, delay_campaign):
+    """One run once gave 'none' on a rig with an 8 ms delay."""
+    runs, _ = delay_campaign
+    result = diagnose([runs["brake_osc_low"]], reference)
+    assert result.verdict == "inconclusive"
+    assert result.findings == []
+    assert "actuator_delay: not identifiable: no actuator step/sweep run" in _notes(result)
+
+
+def test_actuator_runs_alone_name_the_delay_but_leave_the_verdict_open(reference,
+                                                                       delay_campaign):
+    """Actuator runs only once gave "unexplained lag 3.6 ms, no candidate explains" while
+    actuator_delay had scored ΔBIC −3547: contradictory, and unchecked."""
+    runs, rig = delay_campaign
+    result = diagnose([runs["actuator_ramp"], runs["actuator_steps_sweep"]], reference)
+    assert result.verdict == "inconclusive"
+    assert not any(f.cause == "unexplained" for f in result.findings)
+    notes = _notes(result)
+    assert "actuator_delay (delay_s 0.00" in notes and "no run is left to check it on" in notes
+    assert "tire_relaxation: not identifiable: no braking run" in notes
+    scored = next(f for f in result.candidates if f.cause == "actuator_delay")
+    assert scored.parameters["delay_s"] == pytest.approx(rig.number("actuator.delay_s"),
+                                                         abs=1e-3)
+
+
+def test_braking_runs_alone_claim_no_valve_effect_and_end(reference, delay_campaign):
+    """Braking runs only once gave a 13.7 ms delay *and* an "unexplained lag −6.8 ms";
+    with --without gear_walk the pressure_sensor_offset fit ran for over 25 minutes."""
+    runs, _ = delay_campaign
+    braking = [r for name, r in runs.items() if name.startswith("brake_")]
+    result = diagnose(braking, reference, without=("gear_walk",))
+    assert result.verdict == "inconclusive"
+    assert not any(f.cause in ("actuator_delay", "unexplained") for f in result.findings)
+    assert {f.cause for f in result.candidates}.isdisjoint(
+        {"actuator_delay", "pressure_sensor_offset", "actuator_dynamics"})
+    notes = _notes(result)
+    assert "pressure_sensor_offset: not identifiable: no quasi-static actuator ramp" in notes
+
+
+def test_a_delay_from_200_hz_logs_carries_the_logs_timing_uncertainty(reference,
+                                                                      delay_campaign):
+    """200 Hz logs of a rig whose valve command changes at 1 kHz once gave 10.1 ± 0.07 ms
+    for 8 ms: when the command changed within a log period cannot be known."""
+    from msg_tools.run import SIGNALS
+
+    runs, rig = delay_campaign
+    logged = [dataclasses.replace(r, **{n: getattr(r, n)[2::5] for n in ("time_s", *SIGNALS)})
+              for r in runs.values()]
+    result = diagnose(logged, reference)
+    assert result.verdict == "actuator_delay"
+    delay = _finding(result, "actuator_delay")
+    truth = rig.number("actuator.delay_s")
+    assert delay.std["delay_s"] >= 1e-3
+    assert abs(delay.parameters["delay_s"] - truth) <= 2 * delay.std["delay_s"]

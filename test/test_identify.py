@@ -10,14 +10,20 @@ import numpy as np
 import pytest
 
 from landing_gear_sim.calibration import runs as runs_module
+from landing_gear_sim.calibration.braking import prepare
 from landing_gear_sim.calibration.campaign import DEVIATING, generate_campaign, rig_like
+from landing_gear_sim.calibration.friction import fit_friction
 from landing_gear_sim.calibration.identify import identify
 from landing_gear_sim.calibration.measured import simulate_run
-from landing_gear_sim.calibration.runs import RunKind, classify
+from landing_gear_sim.calibration.runs import Family, RunKind, classify, classify_all, select
 from landing_gear_sim.calibration.validate import fit_percent, validate
 from landing_gear_sim.cli import main
+from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import load_parameters
+from landing_gear_sim.model.scenario import constant_pressure_test
+from msg_tools.csv_io import write_csv
 from msg_tools.io import read_campaign
+from msg_tools.units import PA_PER_BAR
 
 SEED = 11  # the hidden rig: datasheet values off by up to ±3 %, never shown to identify()
 
@@ -182,25 +188,84 @@ def test_simulating_a_measured_run_never_adds_noise(campaign_dir, reference):
     assert np.array_equal(first.wheel_speed_rad_s, clean.wheel_speed_rad_s)
 
 
-def test_jittered_timestamps_are_put_on_a_uniform_grid_and_every_step_runs(campaign_dir,
-                                                                           identified,
-                                                                           reference):
+COMPARED = ("actuator.map_k1_pa_per_a", "actuator.natural_frequency_hz",
+            "actuator.damping_ratio", "brake.gain_n_m_per_pa", "flywheel.inertia_kg_m2",
+            "wheel.unloaded_radius_m", "friction.theta1", "friction.theta2", "friction.theta3")
+
+
+def test_jittered_timestamps_are_taken_off_and_every_parameter_stays(campaign_dir, identified,
+                                                                    reference):
     """±10 % timestamp jitter once failed the braking step ("Time steps are not equally
-    spaced") and still wrote a file; the runs are now resampled on their mean rate."""
+    spaced") and still wrote a file; resampling it instead moved ω_n by 3 %. The stamps
+    scatter around the logger's fixed-rate clock: its instants are used, no sample moved."""
     rng = np.random.default_rng(5)
     runs = [dataclasses.replace(r, time_s=r.time_s + rng.uniform(-0.1, 0.1, len(r)) / r.rate_hz)
             for r in read_campaign(campaign_dir).runs]
     jittered = identify(runs, reference, jackknife=False)
     assert jittered.problems == ()
-    for key in ("brake.gain_n_m_per_pa", "flywheel.inertia_kg_m2", "wheel.unloaded_radius_m",
-                "friction.theta1", "friction.theta2", "friction.theta3"):
-        assert jittered.params.number(key) == pytest.approx(identified.params.number(key),
-                                                            rel=0.02), key  # issue 13's 2 %
+    clean = {e.key: e for e in identified.estimates}
+    for key in COMPARED:
+        assert jittered.params.number(key) == pytest.approx(clean[key].value, rel=0.02), key
 
 
-COMPARED = ("actuator.map_k1_pa_per_a", "actuator.natural_frequency_hz",
-            "actuator.damping_ratio", "brake.gain_n_m_per_pa", "flywheel.inertia_kg_m2",
-            "wheel.unloaded_radius_m", "friction.theta1", "friction.theta2", "friction.theta3")
+def test_short_gaps_are_bridged_and_long_ones_split_the_run(campaign_dir, tmp_path, identified,
+                                                           reference):
+    """A logger that dropped 3 samples here and there, and one that lost 0.3 s of the ramp
+    and 0.2 s in the middle of a stop: every parameter as from the complete logs."""
+    folder = tmp_path / "gappy"
+    folder.mkdir()
+    drops = {"actuator_steps_sweep": [slice(5000, 5003), slice(9000, 9002)],
+             "actuator_ramp": [slice(4000, 4300)], "brake_const_30bar": [slice(3000, 3200)]}
+    for source in campaign_dir.glob("*.csv"):
+        lines = source.read_text().splitlines()
+        rows = np.ones(len(lines), dtype=bool)
+        for cut in drops.get(source.stem, []):
+            rows[cut] = False
+        (folder / source.name).write_text("\n".join(np.asarray(lines)[rows]) + "\n")
+    campaign = read_campaign(folder)
+    names = sorted(r.name for r in campaign.runs)
+    assert "actuator_ramp__part1" in names and "actuator_ramp__part2" in names
+    assert "brake_const_30bar__part1" in names and "brake_const_30bar__part2" not in names
+    notes = "\n".join(campaign.problems)
+    assert "actuator_steps_sweep: 2 short gap(s)" in notes
+    assert "brake_const_30bar__part2: left out (it begins mid-stop" in notes
+    gappy = identify(campaign.runs, reference, jackknife=False)
+    assert gappy.complete, gappy.problems
+    _assert_as_clean(gappy, identified)
+
+
+def test_one_long_stop_does_not_decide_the_calibration(campaign_dir, tmp_path, identified,
+                                                      hidden_rig, reference):
+    """A 5-minute low-pressure stop beside the 10-60 s runs once dragged ϑ3 off by 9 %
+    (the direct slip/μ fit, ruled by its 30 000 samples, put the refinement's start so far
+    off that it ended on its bound). Each run now counts at most as a median-length one."""
+    folder = tmp_path / "with_long_stop"
+    shutil.copytree(campaign_dir, folder)
+    rig = hidden_rig.replace({"rig_test.max_duration_s": 400.0}, "a long test")
+    long_stop = simulate(rig, constant_pressure_test(rig, 0.8 * PA_PER_BAR)).to_run(noise=7)
+    assert long_stop.time_s[-1] > 280
+    write_csv(long_stop, folder / "brake_const_long.csv")
+    direct = {name: _direct_friction_fit(path, reference)
+              for name, path in (("without", campaign_dir), ("with", folder))}
+    assert direct["with"] == pytest.approx(direct["without"], rel=0.25)  # was 4x on ϑ3
+    result = identify(read_campaign(folder).runs, reference, jackknife=False)
+    assert result.complete, result.problems
+    _assert_as_clean(result, identified)
+
+
+def _assert_as_clean(result, identified):
+    """Every compared parameter within 2 % or 2 σ of the clean campaign's (issue 13)."""
+    clean = {e.key: e for e in identified.estimates}
+    for key in COMPARED:
+        value, reference_value = result.params.number(key), clean[key].value
+        assert abs(value - reference_value) <= max(0.02 * abs(reference_value),
+                                                   2 * clean[key].std), key
+
+
+def _direct_friction_fit(folder, params):
+    """ϑ1..ϑ3 of the direct slip/μ fit (the refinement's start) on a folder's braking runs."""
+    runs = select(classify_all(read_campaign(folder).runs), [Family.BRAKE])
+    return [e.value for e in fit_friction([prepare(r, params) for r in runs], params)]
 
 
 @pytest.mark.parametrize("noise_a", [1e-3, 2e-3, 1e-2])
@@ -209,19 +274,21 @@ def test_current_logging_noise_changes_neither_classes_nor_parameters(campaign_d
     """1 mA of noise on the logged current once made the ramp 'dynamic' (static map
     skipped) and, at 5 mA, every braking run 'oscillating'; exit 0 all the same.
 
-    At 10 mA the classes hold but ϑ3 moves by up to 15 % (issue 13, open): the model's
-    wheel-lock episodes respond to the noise left in the denoised command."""
+    At 10 mA ϑ3 moves by up to 15 % (seeds 1-3: +2.5, −15, +7.4 %): the model's wheel-lock
+    episodes respond to the noise left in the denoised command. Its σ says so (the
+    leave-one-run-out spread: 3-43 %), so the estimate stays honest."""
     rng = np.random.default_rng(2)
     runs = [dataclasses.replace(r, current_a=r.current_a + rng.normal(0, noise_a, len(r)))
             for r in read_campaign(campaign_dir).runs]
-    noisy = identify(runs, reference, jackknife=False)
+    noisy = identify(runs, reference, jackknife=noise_a >= 5e-3)
     assert noisy.classes == identified.classes
     assert noisy.complete, noisy.problems
     clean = {e.key: e for e in identified.estimates}
-    for key in COMPARED if noise_a < 5e-3 else set(COMPARED) - {"friction.theta3"}:
+    own = {e.key: e for e in noisy.estimates}
+    for key in COMPARED:
         value, reference_value = noisy.params.number(key), clean[key].value
-        assert abs(value - reference_value) <= max(0.02 * abs(reference_value),
-                                                   2 * clean[key].std), key
+        sigma = max(clean[key].std, own[key].std)
+        assert abs(value - reference_value) <= max(0.02 * abs(reference_value), 2 * sigma), key
 
 
 def _rewritten(campaign_dir, folder, run_name, column, factor):
@@ -258,6 +325,8 @@ def test_a_unit_within_physical_ranges_is_still_named(campaign_dir, tmp_path, ca
 
 def test_a_campaign_that_cannot_identify_everything_writes_only_when_asked(campaign_dir,
                                                                          tmp_path, capsys):
+    """Constant-pressure stops only: no valve steps, and a friction curve they cannot pin
+    (its refinement once ended silently on its bound, ϑ3 −64 %)."""
     folder = tmp_path / "braking_only"
     folder.mkdir()
     for run in campaign_dir.glob("brake_const_*.csv"):
@@ -265,11 +334,13 @@ def test_a_campaign_that_cannot_identify_everything_writes_only_when_asked(campa
     out = tmp_path / "out.yaml"
     assert main(["identify", str(folder), "-o", str(out)]) == 2
     error = capsys.readouterr().err
-    assert "not identified: valve static map; actuator dynamics A(s)" in error
+    assert "not identified: valve static map; actuator dynamics A(s); friction curve" in error
     assert "--partial" in error and not out.exists()
     assert main(["identify", str(folder), "-o", str(out), "--partial"]) == 0
     text = out.read_text()
     assert text.startswith("# PARTIAL identification") and "#   valve static map" in text
     evidence = json.loads(out.with_suffix(".identification.json").read_text())
-    assert evidence["not_identified"] == ["valve static map", "actuator dynamics A(s)"]
+    assert evidence["not_identified"] == ["valve static map", "actuator dynamics A(s)",
+                                          "friction curve"]
+    assert any("drove ϑ3 to a factor 0.2" in p for p in evidence["problems"])
     assert load_parameters([out]).number("brake.gain_n_m_per_pa") > 0

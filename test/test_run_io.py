@@ -76,7 +76,6 @@ def test_pressure_in_pa_declared_as_bar_is_caught(tmp_path, run):
 
 
 @pytest.mark.parametrize(("edit", "fragment"), [
-    (lambda rows: rows[:100] + rows[150:], "gap of"),
     (lambda rows: [*rows[:10], rows[10], *rows[10:]], "duplicated time"),
 ])
 def test_broken_time_base_is_named(tmp_path, csv_file, edit, fragment):
@@ -86,6 +85,20 @@ def test_broken_time_base_is_named(tmp_path, csv_file, edit, fragment):
     with pytest.raises(RunFormatError, match=fragment) as error:
         read_csv(bad)
     assert str(bad) in str(error.value)
+
+
+def test_a_lone_run_with_a_long_gap_is_read_but_not_bridged(tmp_path, csv_file):
+    """Gaps are data: converting keeps them; a tool that needs one sample period says why it
+    cannot use the run (a campaign reader splits it, test_identify)."""
+    from landing_gear_sim.calibration.runs import classified
+
+    lines = csv_file.read_text().splitlines()
+    gappy = tmp_path / "gappy.csv"
+    gappy.write_text("\n".join([lines[0], *lines[1:101], *lines[151:]]) + "\n")
+    run = read_csv(gappy)
+    assert len(run) == len(lines) - 51
+    with pytest.raises(RunFormatError, match=r"gappy: 0.05 s missing after t = .*too long"):
+        classified(run)
 
 
 def test_bag_missing_a_topic_is_named(tmp_path, run):

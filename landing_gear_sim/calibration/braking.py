@@ -14,7 +14,12 @@ import scipy.signal
 from scipy.optimize import least_squares
 
 from landing_gear_sim.calibration.runs import ClassifiedRun
-from landing_gear_sim.calibration.statistics import Estimate, covariance_std, linear_std
+from landing_gear_sim.calibration.statistics import (
+    Estimate,
+    covariance_std,
+    linear_std,
+    run_weights,
+)
 from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model.elements import fade_factor
 from landing_gear_sim.model.parameters import RigParameters
@@ -119,8 +124,9 @@ def fit_flywheel(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
     if not blocks:
         raise IdentificationError("no braking run long enough for the flywheel balance")
     offsets = scipy.linalg.block_diag(*[np.ones((len(y), 1)) for y in targets])
-    x = np.hstack([np.vstack(blocks), offsets])
-    y = np.concatenate(targets)
+    weight = _sample_weights(targets)
+    x = np.hstack([np.vstack(blocks), offsets]) * weight[:, None]
+    y = np.concatenate(targets) * weight
     coef, *_ = np.linalg.lstsq(x, y, rcond=None)
     std_inv, std_ratio = linear_std(x, y - x @ coef, x.shape[1])[:2]
     inv_mass, alpha_over_mass = coef[:2]
@@ -135,6 +141,12 @@ def fit_flywheel(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
         Estimate("drag.coeff_n_s2_per_m2", float(alpha), float(std_alpha), names,
                  "integrated momentum balance"),
     ]
+
+
+def _sample_weights(per_run: Sequence[np.ndarray]) -> np.ndarray:
+    """Each sample's run weight (:func:`run_weights`), shape (total samples,)."""
+    sizes = [values.size for values in per_run]
+    return np.repeat(run_weights(sizes), sizes)
 
 
 def _torque_balance(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
@@ -160,7 +172,10 @@ def fit_brake_gain(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
         torque.append(whole[m])
         pressure.append(b.pressure[m])
         energy.append(absorbed[m])
-    t, pr, e = np.concatenate(torque), np.concatenate(pressure), np.concatenate(energy)
+    weight = _sample_weights(torque)
+    # a weighted row of r F_x − J_w ω̇ = k_b f(E) P: torque and pressure scaled, E as it is
+    t, pr = (np.concatenate(column) * weight for column in (torque, pressure))
+    e = np.concatenate(energy)
     names = tuple(b.run.name for b in runs)
     if not p.has("brake_fade"):
         gain = float(pr @ t / (pr @ pr))

@@ -12,7 +12,8 @@ from scipy.optimize import least_squares
 from landing_gear_sim.calibration.braking import LOADED_N, Braking, hub_speed
 from landing_gear_sim.calibration.measured import simulate_run
 from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
-from landing_gear_sim.calibration.statistics import Estimate, covariance_std
+from landing_gear_sim.calibration.statistics import Estimate, covariance_std, run_weights
+from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model.elements import burckhardt_mu, slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rolling_radius_at
@@ -24,34 +25,41 @@ REFINE_BOUNDS = (0.2, 5.0)  # output-error refinement stays within these factors
 def friction_samples(runs: Sequence[Braking], p: RigParameters
                      ) -> tuple[np.ndarray, np.ndarray]:
     """(slip, μ) from eq. (1) and μ = F_x/F_z over the braking phases, decimated to 100 Hz."""
-    slips, mus = [], []
+    per_run = [_run_samples(b, p) for b in runs]
+    return (np.concatenate([slip for slip, _ in per_run]),
+            np.concatenate([mu for _, mu in per_run]))
+
+
+def _run_samples(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
     stop = p.number("rig_test.stop_speed_m_s")
-    for b in runs:
-        m = (b.time_s > b.start_s + 0.3) & (b.speed_m_s > stop + 2.0) & (b.load > LOADED_N) \
-            & (b.wheel > 1.0)
-        idx = np.flatnonzero(m)[::10]
-        radius = rolling_radius_at(p, b.load[idx])
-        slips.append(slip_ratio(hub_speed(b, p)[idx], b.wheel[idx], radius))
-        mus.append(b.force[idx] / b.load[idx])
-    return np.concatenate(slips), np.concatenate(mus)
+    m = (b.time_s > b.start_s + 0.3) & (b.speed_m_s > stop + 2.0) & (b.load > LOADED_N) \
+        & (b.wheel > 1.0)
+    idx = np.flatnonzero(m)[::10]
+    radius = rolling_radius_at(p, b.load[idx])
+    return slip_ratio(hub_speed(b, p)[idx], b.wheel[idx], radius), b.force[idx] / b.load[idx]
 
 
-def fit_friction(slip: np.ndarray, mu: np.ndarray, p: RigParameters, names: tuple[str, ...],
-                 fix_theta3: bool = False) -> list[Estimate]:
-    """Burckhardt ϑ1, ϑ2, ϑ3 by nonlinear least squares (ϑ3 optionally fixed, paper [13])."""
+def fit_friction(runs: Sequence[Braking], p: RigParameters, fix_theta3: bool = False
+                 ) -> list[Estimate]:
+    """Burckhardt ϑ1, ϑ2, ϑ3 by nonlinear least squares on the (slip, μ) samples of the
+    braking runs, each run weighted by :func:`run_weights` (ϑ3 optionally fixed, paper [13])."""
     keys = KEYS
     start = np.array([p.number(k) for k in keys])
     free = 2 if fix_theta3 else 3
+    per_run = [_run_samples(b, p) for b in runs]
+    slip, mu = (np.concatenate(column) for column in zip(*per_run, strict=True))
+    weight = np.repeat(run_weights([s.size for s, _ in per_run]), [s.size for s, _ in per_run])
 
     def residual(theta: np.ndarray) -> np.ndarray:
         t3 = start[2] if fix_theta3 else theta[2]
-        return burckhardt_mu(theta[0], theta[1], t3, slip) - mu
+        return weight * (burckhardt_mu(theta[0], theta[1], t3, slip) - mu)
 
     fit = least_squares(residual, start[:free], x_scale=start[:free],
                         bounds=(np.zeros(free), np.full(free, np.inf)))
     std = covariance_std(fit, free)
     method = "Burckhardt least squares on slip/μ samples" + (" (theta3 fixed)" if fix_theta3
                                                              else "")
+    names = tuple(b.run.name for b in runs)
     estimates = [Estimate(k, float(v), float(s), names, method)
                  for k, v, s in zip(keys[:free], fit.x, std, strict=True)]
     if fix_theta3:
@@ -70,6 +78,7 @@ def refine_friction(runs: Sequence[ClassifiedRun], p: RigParameters, jackknife: 
     keys = KEYS
     start = np.array([p.number(k) for k in keys])
     windows = [braking_window(r, p) for r in runs]
+    weights = run_weights([int(w.sum()) for w in windows])
 
     def slip_error(run: ClassifiedRun, window: np.ndarray, trial: RigParameters) -> np.ndarray:
         # wheel-speed error less what the flywheel-speed error explains: a common speed
@@ -82,10 +91,19 @@ def refine_friction(runs: Sequence[ClassifiedRun], p: RigParameters, jackknife: 
 
     def residual(theta: np.ndarray, chosen: Sequence[int]) -> np.ndarray:
         trial = p.replace(dict(zip(keys, theta * start, strict=True)), "identify")
-        return np.concatenate([slip_error(runs[i], windows[i], trial) for i in chosen])
+        return np.concatenate([weights[i] * slip_error(runs[i], windows[i], trial)
+                               for i in chosen])
 
     fit = least_squares(lambda th: residual(th, range(len(runs))), np.ones(3), diff_step=1e-4,
                         bounds=REFINE_BOUNDS)
+    pinned = np.isclose(fit.x, REFINE_BOUNDS[0]) | np.isclose(fit.x, REFINE_BOUNDS[1])
+    if np.any(pinned):
+        which = ", ".join(f"ϑ{i + 1}" for i in np.flatnonzero(pinned))
+        raise IdentificationError(
+            f"the output-error refinement drove {which} to a factor {REFINE_BOUNDS[0]:g} or "
+            f"{REFINE_BOUNDS[1]:g} of the direct fit's {', '.join(f'{v:.4g}' for v in start)}:"
+            " these braking runs do not pin the curve (constant-pressure stops stay at low "
+            "slip: add oscillating runs, or keep ϑ3 with --fix-theta3)")
     std = covariance_std(fit, 3)
     if jackknife:
         std = np.maximum(std, _jackknife_std(residual, fit.x, len(runs)))

@@ -27,7 +27,7 @@ from landing_gear_sim.calibration.actuator import (
     fit_actuator_dynamics,
     fit_static_map,
 )
-from landing_gear_sim.calibration.friction import fit_friction, friction_samples, refine_friction
+from landing_gear_sim.calibration.friction import fit_friction, refine_friction
 from landing_gear_sim.calibration.plausibility import check_units
 from landing_gear_sim.calibration.runs import ClassifiedRun, Family, RunKind, classify_all, select
 from landing_gear_sim.calibration.statistics import Estimate
@@ -146,8 +146,7 @@ def _braking_steps(state: _Calibration, runs: Sequence[ClassifiedRun], fix_theta
 
 def _friction_step(state: _Calibration, runs: Sequence[ClassifiedRun],
                    prepared: Sequence[br.Braking], fix_theta3: bool, jackknife: bool) -> None:
-    points = friction_samples(prepared, state.params)
-    state.adopt(fit_friction(*points, state.params, tuple(r.name for r in runs), fix_theta3))
+    state.adopt(fit_friction(prepared, state.params, fix_theta3))
     if not fix_theta3:
         state.say("refining the friction curve on the braking runs (output error)")
         refined = refine_friction(runs, state.params, jackknife)

@@ -3,9 +3,11 @@
 A :class:`ClassifiedRun` is a :class:`~msg_tools.run.Run` on a uniform time base that
 knows its :class:`RunKind` and its braking start; identification, validation and
 diagnosis classify the runs they are given once (:func:`classified`) and pass these on.
-A run whose samples are not evenly spaced (timestamp jitter, a logger's float steps) is
-put on the uniform grid of its mean rate first (linear interpolation, the current held):
-every filter, derivative and simulation downstream assumes one sample period.
+Every filter, derivative and simulation downstream assumes one sample period, so a run
+whose stamps are not evenly spaced is put on a uniform grid first: stamps that scatter
+around a fixed-rate clock (a logger's stamping noise, float steps) are replaced by the
+clock's instants and the samples kept; short gaps in it are interpolated (linear, the
+current held); samples taken irregularly are resampled at their mean rate.
 """
 
 from __future__ import annotations
@@ -20,8 +22,10 @@ import numpy as np
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s
 from landing_gear_sim.model.scenario import brake_start_index, current_noise_a
+from msg_tools.errors import RunFormatError
 from msg_tools.io import is_uniform, resample
 from msg_tools.run import Run
+from msg_tools.timebase import MAX_INTERPOLATED_GAP, fixed_rate_clock, on_clock
 
 STILL_FLYWHEEL_RAD_S = 1.0  # an actuator-only run: the flywheel stands still ...
 NO_CONTACT_LOAD_N = 2e3  # ... and the wheel carries (almost) no load
@@ -102,9 +106,23 @@ class ClassifiedRun(Run):
 
 
 def on_uniform_grid(run: Run) -> Run:
-    """``run`` itself if its samples are evenly spaced (to 0.1 % of a period), else
-    resampled at its mean rate rounded to 1 Hz."""
-    return run if is_uniform(run, UNIFORM_TOLERANCE) else resample(run, round(run.rate_hz))
+    """``run`` itself if its samples are evenly spaced (to 0.1 % of a period); on its
+    sampling clock if it has one (gaps of a few samples interpolated); else resampled at
+    its mean rate rounded to 1 Hz. A gap too long to bridge is an error (campaign readers
+    split such runs, :func:`~msg_tools.timebase.split_at_gaps`)."""
+    if is_uniform(run, UNIFORM_TOLERANCE):
+        return run
+    clock = fixed_rate_clock(run.time_s)
+    if clock is None:
+        return resample(run, round(run.rate_hz))
+    missing = clock.missing
+    if missing.max() > MAX_INTERPOLATED_GAP:
+        k = int(np.argmax(missing))
+        raise RunFormatError(f"{run.name}: {missing[k] * clock.period_s:.4g} s missing after "
+                             f"t = {run.time_s[k - 1]:.6g} s, too long to interpolate; read "
+                             "it as part of a campaign to have it split there")
+    run = on_clock(run, clock)
+    return resample(run, 1.0 / clock.period_s) if missing.max() else run
 
 
 def classified(run: Run) -> ClassifiedRun:

@@ -3,6 +3,7 @@ are correlated in time (simulation errors and integrated balances are smooth).""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,3 +53,11 @@ def linear_std(design: np.ndarray, residual: np.ndarray, n_params: int) -> np.nd
     sigma2 = float(residual @ residual) / max(residual.size - n_params, 1)
     cov = np.linalg.pinv(design.T @ design) * sigma2 * correlation_inflation(residual)
     return np.sqrt(np.clip(np.diag(cov), 0.0, None))
+
+
+def run_weights(lengths: Sequence[int]) -> np.ndarray:
+    """Weight on each run's residuals so that no run counts for more than a run of the
+    median length, shape (len(lengths),): a 5-minute stop beside 10-s runs would otherwise
+    decide the fit alone (issue 13). Shorter runs keep weight 1 (no noise inflated)."""
+    n = np.asarray(lengths, dtype=float)
+    return np.sqrt(np.minimum(1.0, np.median(n) / np.maximum(n, 1.0)))

@@ -9,7 +9,9 @@ compare, diagnose, metrics, antiskid); nothing in the package imports this one.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
 from collections.abc import Callable, Sequence
 
 from landing_gear_sim import __version__
@@ -43,11 +45,29 @@ def _check(args: argparse.Namespace, parser: argparse.ArgumentParser) -> None:
             parser.error("--speeds must be > 0")
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM arrived: the command stops as on Ctrl-C (workers ended, no partial output)."""
+
+
+def _terminate(signum: int, frame: object) -> None:
+    raise Terminated
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the CLI; returns the exit code."""
+    """Run the CLI; returns the exit code (130 after Ctrl-C, 143 after SIGTERM)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     _check(args, parser)
+    if threading.current_thread() is not threading.main_thread():
+        return _run(args)  # only the main thread may set handlers (and receives signals)
+    previous = signal.signal(signal.SIGTERM, _terminate)
+    try:
+        return _run(args)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _run(args: argparse.Namespace) -> int:
     try:
         return int(args.func(args))
     except LandingGearSimError as exc:
@@ -56,6 +76,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as exc:  # a disk full or a folder gone while writing: still one line
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 2
+    except Terminated:
+        print(f"{PROG}: terminated", file=sys.stderr)
+        return 143
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return 130

@@ -30,7 +30,14 @@ from landing_gear_sim.diagnosis.catalogue import (
     switched_on,
 )
 from landing_gear_sim.diagnosis.findings import Finding, Signature
-from landing_gear_sim.diagnosis.scoring import Scored, channel_fits, key_std, score_candidate
+from landing_gear_sim.diagnosis.identifiability import actuator_calibrated, untestable
+from landing_gear_sim.diagnosis.scoring import (
+    BIC_THRESHOLD,
+    Scored,
+    channel_fits,
+    key_std,
+    score_candidate,
+)
 from landing_gear_sim.diagnosis.signatures import (
     RunEvidence,
     find_signatures,
@@ -39,10 +46,11 @@ from landing_gear_sim.diagnosis.signatures import (
 )
 from landing_gear_sim.errors import DiagnosisError, IdentificationError
 from landing_gear_sim.model.parameters import ELEMENTS, RigParameters
-from landing_gear_sim.processes import die_with_parent
+from landing_gear_sim.processes import pool_worker
 from msg_tools.run import Run
 
 MAX_ROUNDS = 4
+INCONCLUSIVE = "inconclusive"  # the verdict when the campaign cannot test every candidate
 FRICTION_CURVE = "friction_curve"
 REMOVABLE = (*ELEMENTS, FRICTION_CURVE)
 
@@ -105,9 +113,9 @@ def diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str] = 
     simulated_before = simulate_all(runs, calibrated)
     baseline = baseline_fits(runs, simulated_before)
     say("analysing the residuals of the calibrated model")
-    before = find_signatures(runs, calibrated, simulated_before)
+    before = _interpretable(find_signatures(runs, calibrated, simulated_before), runs)
     scales = noise_scales(runs, tuple(CHANNELS))
-    pending = candidates_for(start, without)
+    pending, skipped = _testable(candidates_for(start, without), runs, problems, say)
     model = calibrated
     accepted: list[Scored] = []
     table: list[Finding] = []
@@ -134,15 +142,58 @@ def diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str] = 
                    if s is not best and (s.finding.delta_bic or 0.0) < 0]
     say("analysing the residuals of the extended model")
     simulated_after = simulate_all(runs, model)
-    after = find_signatures(runs, model, simulated_after)
+    after = _interpretable(find_signatures(runs, model, simulated_after), runs)
     findings = [s.finding for s in accepted]
-    if after:
-        findings.append(unexplained(after, baseline_fits(runs, simulated_after)))
-    verdict = findings[0].cause if findings else "none"
+    unchecked = _unchecked(table) if not accepted else []
+    problems.extend(f"{f.cause} ({_in_words(f.parameters)}): fits the runs it was fitted on "
+                    f"better (ΔBIC {f.delta_bic:+.0f}) but no run is left to check it on: too "
+                    "little held-out data for a verdict" for f in unchecked)
+    if accepted or not (skipped or unchecked):
+        if after:
+            findings.append(unexplained(after, baseline_fits(runs, simulated_after)))
+        verdict = findings[0].cause if findings else "none"
+    else:
+        # not 'none' (a catalogued effect may hide in what could not be tested), and no
+        # 'unexplained' either: an untested candidate may be what the residual shows
+        verdict = INCONCLUSIVE
     evidence = [run_evidence(*sims, calibrated)
                 for sims in zip(runs, simulated_before, simulated_after, strict=True)]
     return Diagnosis(verdict, findings, table, baseline, start, calibrated, model,
                      before, after, problems, evidence)
+
+
+def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],
+              problems: list[str], say: Progress) -> tuple[list[Candidate], list[str]]:
+    """The candidates the runs can identify; the others noted in ``problems`` (causes)."""
+    testable, skipped = [], []
+    for candidate in candidates:
+        reason = untestable(candidate, runs)
+        if reason:
+            problems.append(f"{candidate.cause}: {reason}")
+            say(f"{candidate.cause}: skipped, {reason}")
+            skipped.append(candidate.cause)
+        else:
+            testable.append(candidate)
+    return testable, skipped
+
+
+def _interpretable(signatures: list[Signature], runs: Sequence[ClassifiedRun]
+                   ) -> list[Signature]:
+    """Residual signatures that say something about the rig: a pressure residual left by
+    an uncalibrated valve (no actuator runs) says only that the datasheet is off."""
+    if actuator_calibrated(runs):
+        return signatures
+    return [s for s in signatures if s.channel != "pressure_pa"]
+
+
+def _in_words(parameters: dict[str, float]) -> str:
+    return ", ".join(f"{name} {value:.4g}" for name, value in parameters.items())
+
+
+def _unchecked(table: Sequence[Finding]) -> list[Finding]:
+    """Candidates the fitting runs support that no held-out run could confirm."""
+    return [f for f in table if f.held_out is None and f.delta_bic is not None
+            and f.delta_bic < BIC_THRESHOLD]
 
 
 def _score_one(candidate: Candidate, runs: Sequence[ClassifiedRun], model: RigParameters,
@@ -164,14 +215,23 @@ def _score_all(pending: Sequence[Candidate], runs: Sequence[ClassifiedRun], mode
         return [_score_one(c, runs, model, datasheet, scales, signatures) for c in pending]
     # fork: the children inherit the compiled physics instead of compiling it again
     context = multiprocessing.get_context("fork")
-    with ProcessPoolExecutor(workers, mp_context=context,
-                             initializer=die_with_parent) as pool:
+    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=pool_worker)
+    try:
         futures = {pool.submit(_score_one, c, runs, model, datasheet, scales, signatures): c
                    for c in pending}
         for future in as_completed(futures):
             say(f"  {futures[future].cause} scored")
-        return [next(f for f, c in futures.items() if c is candidate).result()
-                for candidate in pending]
+        results = [next(f for f, c in futures.items() if c is candidate).result()
+                   for candidate in pending]
+    except BaseException:
+        # Ctrl-C or SIGTERM: the workers' fits could run for minutes; an executor's exit
+        # would wait for them
+        for child in multiprocessing.active_children():
+            child.terminate()
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown()
+    return results
 
 
 def _recalibrate(runs: Sequence[ClassifiedRun], start: RigParameters, accepted: list[Scored],

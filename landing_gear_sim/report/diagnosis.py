@@ -11,7 +11,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from landing_gear_sim.calibration.measured import CHANNELS
-from landing_gear_sim.diagnosis.diagnose import Diagnosis
+from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
 from landing_gear_sim.diagnosis.residuals import Spectrum
 from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, HELD_OUT_THRESHOLD
 from landing_gear_sim.report.figures import DISPLAY_UNITS, save_figure
@@ -139,6 +139,9 @@ def diagnosis_summary(result: Diagnosis) -> str:
                                        rows) if rows else "  (none: the model has them all)"]
     lines.append(f"baseline fit %: {_fits(result.baseline)}")
     lines.append(f"VERDICT: {result.verdict}")
+    if result.verdict == INCONCLUSIVE:
+        lines.append("  the runs given cannot test every candidate, or none is left to check one "
+                     "on: see the notes")
     for f in result.findings:
         values = ", ".join(f"{k} = {v:.6g}" + (f" ± {f.std[k]:.2g}" if k in f.std else "")
                            for k, v in f.parameters.items())

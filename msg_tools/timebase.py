@@ -1,0 +1,121 @@
+"""A run's clock: stamping noise told from irregular sampling, gaps found, and a run with
+long gaps split into parts.
+
+Rig loggers sample on a fixed-rate clock and stamp each row, often from a clock that is not
+the sampler's (a PC's, a bag's receive time, a float with few digits): the stamps scatter
+around the sampler's grid while the samples themselves are even. :func:`fixed_rate_clock`
+finds that grid (each row's index on it and the grid's period and origin by least squares);
+a run whose stamps leave it is sampled irregularly and gets resampled instead.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from .checks import BRAKING_PRESSURE_PA, CONTACT_LOAD_N
+from .run import SIGNALS, Run
+
+MAX_STAMP_NOISE = 0.3  # of a period: stamps within this of the fitted grid are on it
+MAX_INTERPOLATED_GAP = 5  # missing samples bridged by interpolation; longer gaps split a run
+MIN_PART_S = 1.0  # a part of a split run shorter than this carries too little to keep
+PART = "__part"  # a split run's parts are named <run>__part1, <run>__part2, ...
+
+
+@dataclass(frozen=True)
+class Clock:
+    """A fixed-rate sampling clock: row i was sampled at ``start_s + index[i] * period_s``."""
+
+    start_s: float
+    period_s: float
+    index: np.ndarray
+    """Integer position of each row on the grid, shape (n,), strictly increasing from 0."""
+
+    @property
+    def times_s(self) -> np.ndarray:
+        """The rows' instants on the grid [s], shape (n,)."""
+        return self.start_s + self.index * self.period_s
+
+    @property
+    def missing(self) -> np.ndarray:
+        """Samples missing before each row, shape (n,) (0 where none)."""
+        return np.concatenate([[0], np.diff(self.index) - 1])
+
+
+def fixed_rate_clock(time_s: np.ndarray) -> Clock | None:
+    """The fixed-rate grid the stamps ``time_s`` [s] scatter around (by less than 30 % of a
+    period), or None if the samples were not taken on one."""
+    steps = np.diff(time_s)
+    nominal = float(np.median(steps))
+    if time_s.size < 3 or nominal <= 0:
+        return None
+    # each step rounded on its own: a slightly wrong nominal period cannot accumulate
+    index = np.concatenate([[0], np.cumsum(np.maximum(np.rint(steps / nominal), 1))])
+    for _ in range(2):
+        period, start = np.polyfit(index, time_s, 1)
+        index = np.concatenate([[0], np.cumsum(np.maximum(np.rint(steps / period), 1))])
+    period, start = np.polyfit(index, time_s, 1)
+    if np.max(np.abs(time_s - start - index * period)) > MAX_STAMP_NOISE * period:
+        return None
+    return Clock(float(start), float(period), index.astype(np.int64))
+
+
+def on_clock(run: Run, clock: Clock) -> Run:
+    """``run`` with its stamps replaced by the grid's instants (no sample moved)."""
+    return dataclasses.replace(run, time_s=clock.times_s)
+
+
+@dataclass(frozen=True)
+class Split:
+    """A run cut at its long gaps: the parts kept and one note per gap or part left out."""
+
+    parts: tuple[Run, ...]
+    notes: tuple[str, ...]
+
+
+def split_at_gaps(run: Run) -> Split:
+    """``run`` as it is, or its parts between gaps of more than MAX_INTERPOLATED_GAP missing
+    samples; short gaps are noted (they are interpolated where a uniform grid is needed).
+
+    A part that begins while the brake acts on the loaded wheel is left out: a simulation
+    cannot start mid-stop from the measured state. So is a part shorter than MIN_PART_S.
+    """
+    clock = fixed_rate_clock(run.time_s)
+    if clock is None:
+        return Split((run,), ())
+    missing = clock.missing
+    notes = [f"{run.name}: {int(np.sum((missing > 0) & (missing <= MAX_INTERPOLATED_GAP)))} "
+             f"short gap(s) of ≤ {MAX_INTERPOLATED_GAP} samples, interpolated"] \
+        if np.any((missing > 0) & (missing <= MAX_INTERPOLATED_GAP)) else []
+    cuts = np.flatnonzero(missing > MAX_INTERPOLATED_GAP)
+    if not cuts.size:
+        return Split((run,), tuple(notes))
+    for k in cuts:
+        notes.append(f"{run.name}: {missing[k] * clock.period_s:.4g} s missing after "
+                     f"t = {run.time_s[k - 1]:.6g} s; the run is split there")
+    parts = []
+    for number, (lo, hi) in enumerate(zip([0, *cuts], [*cuts, len(run)], strict=True), 1):
+        part = _part(run, lo, hi, number)
+        reason = _unusable(part)
+        if reason:
+            notes.append(f"{part.name}: left out ({reason})")
+        else:
+            parts.append(part)
+    return Split(tuple(parts), tuple(notes))
+
+
+def _part(run: Run, lo: int, hi: int, number: int) -> Run:
+    fields = {name: getattr(run, name)[lo:hi] for name in ("time_s", *SIGNALS)}
+    return dataclasses.replace(run, name=f"{run.name}{PART}{number}", **fields)
+
+
+def _unusable(part: Run) -> str:
+    if len(part) < 3 or part.time_s[-1] - part.time_s[0] < MIN_PART_S:
+        return f"shorter than {MIN_PART_S:g} s"
+    head = slice(0, 5)
+    if (np.median(part.vertical_load_n[head]) > CONTACT_LOAD_N
+            and np.median(part.pressure_pa[head]) > BRAKING_PRESSURE_PA):
+        return "it begins mid-stop, with the brake acting on the loaded wheel"
+    return ""

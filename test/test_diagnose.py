@@ -315,3 +315,19 @@ def test_a_delay_from_200_hz_logs_carries_the_logs_timing_uncertainty(reference,
     truth = rig.number("actuator.delay_s")
     assert delay.std["delay_s"] >= 1e-3
     assert abs(delay.parameters["delay_s"] - truth) <= 2 * delay.std["delay_s"]
+
+
+def test_a_wheel_channel_out_of_step_is_not_none(reference, tmp_path):
+    """A logger whose wheel channel lags the others by 20 ms once gave 'none'."""
+    runs, _ = _campaign(reference, tmp_path, 121)
+    skew = 20
+
+    def late(r):
+        return dataclasses.replace(r, wheel_speed_rad_s=np.concatenate(
+            [np.full(skew, r.wheel_speed_rad_s[0]), r.wheel_speed_rad_s[:-skew]]))
+
+    result = diagnose([late(r) if r.name.startswith("brake_") else r for r in runs], reference)
+    assert result.verdict == "unexplained"
+    finding = _finding(result, "unexplained")
+    assert finding.parameters["lag_s"] == pytest.approx(skew / 1000, abs=2e-3)
+    assert "measured wheel_speed_rad_s lags the simulation" in finding.evidence

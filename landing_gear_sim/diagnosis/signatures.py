@@ -80,7 +80,7 @@ def find_signatures(runs: Sequence[ClassifiedRun], params: RigParameters,
     """Structure of the residuals of ``params`` (``simulated``: the runs simulated with it)
     that recurs in at least two runs."""
     lines: dict[str, list[tuple[str, float, float]]] = {}
-    lags: list[tuple[str, float]] = []
+    lags: dict[str, list[tuple[str, float]]] = {}
     correlations: dict[str, list[tuple[str, float, float]]] = {}
     for run, model in zip(runs, simulated, strict=True):
         channels = ["pressure_pa"] + (["wheel_speed_rad_s"] if run.braking else [])
@@ -97,9 +97,15 @@ def find_signatures(runs: Sequence[ClassifiedRun], params: RigParameters,
                                                     _regressors(run, params).items()}):
                     correlations.setdefault(c.name, []).append((run.name, c.value, c.band))
         if np.ptp(run.pressure_pa) > LAG_PRESSURE_SPAN_PA:
-            lags.append((run.name, rs.lag_samples(run.pressure_pa, model.pressure_pa, 50)
-                         / run.rate_hz))
-    return [*_recurring_lines(lines), *_consistent_lag(lags, runs),
+            lags.setdefault("pressure_pa", []).append(
+                (run.name, rs.lag_samples(run.pressure_pa, model.pressure_pa, 50) / run.rate_hz))
+        if run.braking and window.sum() >= MIN_SPECTRUM_SAMPLES:
+            # a logger channel out of step with the others (20 ms once gave 'none')
+            lags.setdefault("wheel_speed_rad_s", []).append(
+                (run.name, rs.lag_samples(run.wheel_speed_rad_s[window],
+                                          model.wheel_speed_rad_s[window], 50) / run.rate_hz))
+    return [*_recurring_lines(lines),
+            *(s for channel, found in lags.items() for s in _consistent_lag(channel, found, runs)),
             *_consistent_correlations(correlations)]
 
 
@@ -121,7 +127,8 @@ def _recurring_lines(lines: dict[str, list[tuple[str, float, float]]]) -> list[S
     return out
 
 
-def _consistent_lag(lags: list[tuple[str, float]], runs: Sequence[Run]) -> list[Signature]:
+def _consistent_lag(channel: str, lags: list[tuple[str, float]], runs: Sequence[Run]
+                    ) -> list[Signature]:
     if len(lags) < 2:
         return []
     values = np.array([v for _, v in lags])
@@ -129,7 +136,7 @@ def _consistent_lag(lags: list[tuple[str, float]], runs: Sequence[Run]) -> list[
     median = float(np.median(values))
     same_sign = np.mean(np.sign(values) == np.sign(median))
     if abs(median) * rate >= LAG_SAMPLES and same_sign >= 0.75:
-        return [Signature(SignatureKind.LAG, "pressure_pa", median, abs(median) * rate,
+        return [Signature(SignatureKind.LAG, channel, median, abs(median) * rate,
                           tuple(n for n, _ in lags))]
     return []
 

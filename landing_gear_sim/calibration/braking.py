@@ -149,7 +149,7 @@ def _sample_weights(per_run: Sequence[np.ndarray]) -> np.ndarray:
     return np.repeat(run_weights(sizes), sizes)
 
 
-def _torque_balance(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
+def torque_balance(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
     """Brake torque r F_x − J_w ω̇ [N m] and the energy the brake absorbed, ∫ T_b ω dt [J]."""
     torque = rolling_radius_at(p, b.load) * b.force - p.number("wheel.inertia_kg_m2") * b.wheel_rate
     dt = np.diff(b.time_s, prepend=b.time_s[0])
@@ -166,7 +166,7 @@ def fit_brake_gain(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
     """
     torque, pressure, energy = [], [], []
     for b in runs:
-        whole, absorbed = _torque_balance(b, p)
+        whole, absorbed = torque_balance(b, p)
         m = ((b.time_s > b.start_s + 0.2) & (b.pressure > 3 * PA_PER_BAR) & (b.wheel > 5.0)
              & (b.load > LOADED_N))
         torque.append(whole[m])

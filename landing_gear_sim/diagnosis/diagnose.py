@@ -29,6 +29,12 @@ from landing_gear_sim.diagnosis.catalogue import (
     noise_scales,
     switched_on,
 )
+from landing_gear_sim.diagnosis.consistency import (
+    Check,
+    check_campaign,
+    inconsistent,
+    violations,
+)
 from landing_gear_sim.diagnosis.findings import Finding, Signature
 from landing_gear_sim.diagnosis.identifiability import actuator_calibrated, untestable
 from landing_gear_sim.diagnosis.scoring import (
@@ -71,6 +77,8 @@ class Diagnosis:
     problems: list[str] = field(default_factory=list)
     evidence: list[RunEvidence] = field(default_factory=list)
     """Per run: the simulations compared and the residual spectrum (for the report)."""
+    consistency: list[Check] = field(default_factory=list)
+    """The relations the rig measures twice, checked under the extended model."""
 
     def to_json(self) -> dict[str, object]:
         return {"verdict": self.verdict, "findings": [f.to_json() for f in self.findings],
@@ -78,6 +86,7 @@ class Diagnosis:
                 "candidates": [f.to_json() | {"accepted": f.accepted} for f in self.candidates],
                 "signatures_before": [s.describe() for s in self.signatures_before],
                 "signatures_after": [s.describe() for s in self.signatures_after],
+                "consistency": [c.to_json() for c in self.consistency],
                 "problems": self.problems}
 
 
@@ -144,6 +153,8 @@ def diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str] = 
     simulated_after = simulate_all(runs, model)
     after = _interpretable(find_signatures(runs, model, simulated_after), runs)
     findings = [s.finding for s in accepted]
+    say("checking the relations the rig measures twice")
+    checks = check_campaign(runs, model)
     unchecked = _unchecked(table) if not accepted else []
     problems.extend(f"{f.cause} ({_in_words(f.parameters)}): fits the runs it was fitted on "
                     f"better (ΔBIC {f.delta_bic:+.0f}) but no run is left to check it on: too "
@@ -151,6 +162,8 @@ def diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str] = 
     if accepted or not (skipped or unchecked):
         if after:
             findings.append(unexplained(after, baseline_fits(runs, simulated_after)))
+        if violations(checks):
+            findings.append(inconsistent(violations(checks)))
         verdict = findings[0].cause if findings else "none"
     else:
         # not 'none' (a catalogued effect may hide in what could not be tested), and no
@@ -159,7 +172,7 @@ def diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str] = 
     evidence = [run_evidence(*sims, calibrated)
                 for sims in zip(runs, simulated_before, simulated_after, strict=True)]
     return Diagnosis(verdict, findings, table, baseline, start, calibrated, model,
-                     before, after, problems, evidence)
+                     before, after, problems, evidence, checks)
 
 
 def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],

@@ -11,6 +11,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from landing_gear_sim.calibration.measured import CHANNELS
+from landing_gear_sim.diagnosis.consistency import Z_VIOLATED, Check
 from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
 from landing_gear_sim.diagnosis.residuals import Spectrum
 from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, HELD_OUT_THRESHOLD
@@ -109,6 +110,8 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
                     ["model", "signature"],
                     [["calibrated starting model", s.describe()] for s in result.signatures_before]
                     + [["extended model", s.describe()] for s in result.signatures_after]))]
+    if result.consistency:
+        sections.append(_consistency_section(result.consistency, folder))
     for item in result.evidence:
         run = item.run
         channels = (("pressure_pa", "wheel_speed_rad_s", "longitudinal_force_n") if run.braking
@@ -124,6 +127,34 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
             body += html_image(figure, folder)
         sections.append((f"{run.name} ({run.kind})", body))
     return sections
+
+
+def _consistency_section(checks: Sequence[Check], folder: Path) -> tuple[str, str]:
+    table = html_table(["relation", "run", "phase", "deviation", "1σ", "floor", "violated"],
+                       [[c.relation, c.run, c.phase, f"{c.deviation:+.4g} {c.unit}",
+                         f"{c.std:.2g}", f"{c.floor:.2g}", "YES" if c.violated else "no"]
+                        for c in checks])
+    figure = plot_consistency(checks, folder / "consistency.png")
+    return ("Consistency of what the rig measures twice", html_image(figure, folder) + table)
+
+
+def plot_consistency(checks: Sequence[Check], path: Path) -> Path:
+    """Each check's deviation in σ (log scale) against the violation threshold; a check
+    whose deviation is also under its physical floor is drawn grey."""
+    labels = [f"{c.relation} — {c.run}" for c in checks]
+    sigmas = [max(min(c.z, 1e4), 1e-2) for c in checks]
+    colours = ["tab:red" if c.violated else ("tab:orange" if c.z > Z_VIOLATED else "tab:grey")
+               for c in checks]
+    fig, ax = plt.subplots(figsize=(9, 0.3 * len(checks) + 1.2))
+    ax.barh(range(len(checks)), sigmas, color=colours)
+    ax.axvline(Z_VIOLATED, color="k", linestyle="--", label=f"{Z_VIOLATED:g} σ")
+    ax.set_xscale("log")
+    ax.set_yticks(range(len(checks)), labels, fontsize=7)
+    ax.invert_yaxis()
+    ax.set_xlabel("|deviation| / σ (red: violated; orange: over σ but under its physical floor)")
+    ax.legend(loc="lower right")
+    fig.tight_layout()
+    return save_figure(fig, path)
 
 
 def _text(value: float | None) -> str:
@@ -151,6 +182,10 @@ def diagnosis_summary(result: Diagnosis) -> str:
                              for c in f.fit_after)
             lines.append(f"    held-out gain: {gain}")
         lines.append(f"    evidence: {f.evidence}")
+    broken = [c for c in result.consistency if c.violated]
+    lines.append(f"consistency: {len(result.consistency)} relations checked, "
+                 f"{len(broken)} violated" + (":" if broken else ""))
+    lines.extend(f"  {c.describe()}" for c in broken)
     lines.extend(f"  note: {problem}" for problem in result.problems)
     return "\n".join(lines)
 

@@ -1,0 +1,172 @@
+"""Consistency of what the rig measures twice (issue 14, part 1).
+
+The rig measures more than the model needs. Relations that hold whatever the model's
+parameters are checked on each run and phase, against their noise; a violation is evidence
+on its own, even where the calibrated model fits well (a calibration can bend the friction
+curve, the brake gain or the drag to swallow an effect the relations still show):
+
+* free rolling (no brake): the load cell's F_x is the wheel's own inertia, J_w ω̇ / r;
+* zero current ⇒ zero pressure (once the valve has settled);
+* no contact (actuator-only runs) ⇒ zero loads;
+* the brake gain of the wheel's torque balance r F_x − J_w ω̇ = k_b P does not depend on
+  the speed or on the pressure level (a local k_b, fitted with a linear trend).
+
+Each check is a deviation with its 1-σ from the residual's own noise (autocorrelation
+counted) and a physical floor below which nothing matters; violated when it exceeds both
+Z_VIOLATED σ and the floor. No plotting here (:mod:`landing_gear_sim.report.diagnosis`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration.runs import ClassifiedRun, RunKind
+from landing_gear_sim.calibration.statistics import linear_std
+from landing_gear_sim.diagnosis.findings import Finding
+from landing_gear_sim.diagnosis.scoring import effective_count
+from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.quantities import rolling_radius_at
+from landing_gear_sim.model.sensors import SensorModel
+from msg_tools.units import PA_PER_BAR
+
+Z_VIOLATED = 6.0  # σ: with a dozen checks per campaign, no false alarm from noise
+FORCE_FLOOR_N = 150.0  # a load-cell offset or crosstalk smaller than this does not matter
+PRESSURE_FLOOR_PA = 0.2 * PA_PER_BAR
+TREND_FLOOR = 0.05  # a brake gain changing by less than 5 % over the range does not matter
+SETTLED_S = 0.3  # after a current change the valve has settled
+MIN_SAMPLES = 200
+
+
+@dataclass(frozen=True)
+class Check:
+    """One relation on one run (or the campaign) and phase: the deviation found, its 1-σ
+    and the floor below which it does not matter, in ``unit``."""
+
+    relation: str
+    run: str
+    phase: str
+    deviation: float
+    std: float
+    floor: float
+    unit: str
+
+    @property
+    def z(self) -> float:
+        return abs(self.deviation) / self.std if self.std > 0 else math.inf
+
+    @property
+    def violated(self) -> bool:
+        return self.z > Z_VIOLATED and abs(self.deviation) > self.floor
+
+    def describe(self) -> str:
+        return (f"{self.relation} ({self.run}, {self.phase}): {self.deviation:+.4g} {self.unit} "
+                f"± {self.std:.2g} ({self.z:.0f}σ)" + ("  VIOLATED" if self.violated else ""))
+
+    def to_json(self) -> dict[str, object]:
+        return {"relation": self.relation, "run": self.run, "phase": self.phase,
+                "deviation": self.deviation, "std": self.std, "floor": self.floor,
+                "unit": self.unit, "violated": self.violated}
+
+
+def check_campaign(runs: Sequence[ClassifiedRun], params: RigParameters) -> list[Check]:
+    """Every check the runs allow, under ``params`` (radius law, wheel inertia, sensor
+    offset of the calibrated model)."""
+    checks = [c for run in runs for c in _run_checks(run, params)]
+    braking = [br.prepare(r, params) for r in runs if r.braking]
+    if braking:
+        checks.extend(_gain_trends(braking, params))
+    return checks
+
+
+def violations(checks: Sequence[Check]) -> list[Check]:
+    """The violated checks, strongest first."""
+    return sorted((c for c in checks if c.violated), key=lambda c: -c.z)
+
+
+def inconsistent(broken: Sequence[Check]) -> Finding:
+    """Violated relations as an ``unexplained`` finding (nothing in the model explains
+    them): the strongest one's deviation, every one in the evidence."""
+    best = broken[0]
+    return Finding("unexplained", {"deviation": best.deviation}, {"deviation": best.std},
+                   "measured relations the model cannot break are violated: "
+                   + "; ".join(c.describe() for c in broken[:4])
+                   + (f"; and {len(broken) - 4} more" if len(broken) > 4 else ""),
+                   {}, {}, None, None, False, tuple(sorted({c.run for c in broken})), ())
+
+
+def _run_checks(run: ClassifiedRun, params: RigParameters) -> list[Check]:
+    checks = [_zero_current(run, params)]
+    if run.braking:
+        checks.append(_free_rolling(br.prepare(run, params), params))
+    elif run.kind in (RunKind.ACTUATOR_RAMP, RunKind.ACTUATOR_DYNAMIC):
+        checks.extend(_mean_check("no contact ⇒ no load", run.name, "whole run",
+                                  getattr(run, name), FORCE_FLOOR_N, "N", label)
+                      for name, label in (("vertical_load_n", "F_z"),
+                                          ("longitudinal_force_n", "F_x")))
+    return [c for c in checks if c is not None]
+
+
+def _mean_check(relation: str, run: str, phase: str, values: np.ndarray, floor: float,
+                unit: str, label: str = "") -> Check | None:
+    if values.size < MIN_SAMPLES:
+        return None
+    mean = float(np.mean(values))
+    std = float(np.std(values)) / math.sqrt(effective_count(values - mean))
+    return Check(relation + (f": {label}" if label else ""), run, phase, mean, std, floor, unit)
+
+
+def _zero_current(run: ClassifiedRun, params: RigParameters) -> Check | None:
+    """Pressure where the current has been zero for SETTLED_S (before braking, between
+    pulses): a valve that is shut holds no pressure (the model's sensor offset aside)."""
+    off = run.current_a <= 0.0
+    samples = max(1, round(SETTLED_S * run.rate_hz))
+    settled = np.convolve(off, np.ones(samples), mode="full")[:off.size] >= samples
+    pressure = SensorModel.of(params).true_pressure(run.pressure_pa[settled])
+    return _mean_check("zero current ⇒ zero pressure", run.name, "current off", pressure,
+                       PRESSURE_FLOOR_PA, "Pa")
+
+
+def _free_rolling(b: br.Braking, params: RigParameters) -> Check | None:
+    """F_x before the brake acts, less the wheel's inertia force J_w ω̇ / r."""
+    m = br.free_rolling(b)
+    radius = rolling_radius_at(params, b.load[m])
+    inertia = params.number("wheel.inertia_kg_m2") * b.wheel_rate[m] / radius
+    return _mean_check("free rolling ⇒ F_x = J_w ω̇ / r", b.run.name, "before braking",
+                       b.run.longitudinal_force_n[m] - inertia, FORCE_FLOOR_N, "N")
+
+
+def _gain_trends(runs: Sequence[br.Braking], params: RigParameters) -> list[Check]:
+    """k_b of the torque balance with a linear trend in speed, and in pressure, over the
+    braking runs: the relative change over the range seen [1]."""
+    torque, pressure, speed = [], [], []
+    for b in runs:
+        whole, _ = br.torque_balance(b, params)
+        m = ((b.time_s > b.start_s + 0.2) & (b.pressure > 3 * PA_PER_BAR) & (b.wheel > 5.0)
+             & (b.load > br.LOADED_N))
+        torque.append(whole[m][::10])
+        pressure.append(b.pressure[m][::10])
+        speed.append(b.speed_m_s[m][::10])
+    t, p, v = (np.concatenate(x) for x in (torque, pressure, speed))
+    if t.size < MIN_SAMPLES:
+        return []
+    return [_trend("brake gain constant in speed", t, p, v, "m/s"),
+            _trend("brake gain linear in pressure", t, p, p / PA_PER_BAR, "bar")]
+
+
+def _trend(relation: str, torque: np.ndarray, pressure: np.ndarray, variable: np.ndarray,
+           unit: str) -> Check:
+    """T = k_b P (1 + β (x − x̄)/(x_max − x_min)): β is the relative change of the gain over
+    the range of x seen."""
+    span = float(np.ptp(variable)) or 1.0
+    centred = (variable - variable.mean()) / span
+    design = np.column_stack([pressure, pressure * centred])
+    coef, *_ = np.linalg.lstsq(design, torque, rcond=None)
+    std = linear_std(design, torque - design @ coef, 2)
+    gain = coef[0]
+    return Check(relation, "campaign", f"{variable.min():.3g}–{variable.max():.3g} {unit}",
+                 float(coef[1] / gain), float(std[1] / abs(gain)), TREND_FLOOR, "of k_b")

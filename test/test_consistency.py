@@ -1,0 +1,64 @@
+"""Consistency of what the rig measures twice: effects a calibration can swallow still show
+(issue 14, part 1). Hidden effects are drawn from the test's own RNG and applied to the
+generated logs; the code under test never sees them."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
+from landing_gear_sim.calibration.identify import identify
+from landing_gear_sim.calibration.runs import classify_all
+from landing_gear_sim.diagnosis.consistency import check_campaign, violations
+from landing_gear_sim.diagnosis.diagnose import diagnose
+from msg_tools.io import read_campaign
+
+RUNS = ("actuator_ramp", "actuator_steps_sweep", "brake_const_30bar", "brake_const_40bar",
+        "brake_osc_low", "brake_osc_high")
+
+
+@pytest.fixture(scope="module")
+def clean_runs(reference, tmp_path_factory):
+    folder = tmp_path_factory.mktemp("consistency")
+    generate_campaign(folder, rig_like(reference, np.random.default_rng(130)), 130, RUNS)
+    return classify_all(read_campaign(folder).runs)
+
+
+def _with_crosstalk(runs, fraction):
+    """A longitudinal load-cell channel that carries ``fraction`` of the vertical one."""
+    return classify_all([dataclasses.replace(
+        r, longitudinal_force_n=r.longitudinal_force_n + fraction * r.vertical_load_n)
+        for r in runs])
+
+
+def _free_rolling_load(run):
+    """Mean F_z over the last second before the brake acts (from the log alone)."""
+    m = (run.time_s > run.brake_start_s - 1.0) & (run.time_s < run.brake_start_s - 0.05)
+    return float(np.mean(run.vertical_load_n[m]))
+
+
+def test_clean_logs_violate_no_relation(clean_runs, reference):
+    params = identify(clean_runs, reference, jackknife=False).params
+    checks = check_campaign(clean_runs, params)
+    assert len(checks) >= 12
+    assert violations(checks) == [], [c.describe() for c in violations(checks)]
+
+
+def test_load_cell_crosstalk_the_calibration_swallows_is_found_and_measured(clean_runs,
+                                                                            reference):
+    """A longitudinal channel that is not clean once got 'none': the calibration bent the
+    drag and the brake gain to absorb it. The free-rolling relation does not bend."""
+    rng = np.random.default_rng(131)
+    fraction = rng.choice([-1, 1]) * rng.uniform(0.008, 0.03)
+    runs = _with_crosstalk(clean_runs, fraction)
+    result = diagnose(runs, reference)
+    assert result.verdict == "unexplained", result.verdict
+    finding = result.findings[0]
+    assert "free rolling ⇒ F_x = J_w ω̇ / r" in finding.evidence
+    expected = fraction * np.mean([_free_rolling_load(r) for r in runs if r.braking])
+    assert finding.parameters["deviation"] == pytest.approx(expected, rel=0.1)
+    broken = {c.relation for c in result.consistency if c.violated}
+    assert "free rolling ⇒ F_x = J_w ω̇ / r" in broken

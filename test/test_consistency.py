@@ -62,3 +62,24 @@ def test_load_cell_crosstalk_the_calibration_swallows_is_found_and_measured(clea
     assert finding.parameters["deviation"] == pytest.approx(expected, rel=0.1)
     broken = {c.relation for c in result.consistency if c.violated}
     assert "free rolling ⇒ F_x = J_w ω̇ / r" in broken
+
+
+def test_a_brake_gain_that_falls_with_speed_is_not_none(reference, tmp_path):
+    """Brake torque per bar that is not constant over a stop once got 'none': the
+    calibration bent the friction curve and the brake gain to swallow it. The torque
+    balance's local gain shows the trend. (Drawn by the test: k_b falls 10-25 % over
+    0-190 rad/s of wheel speed; the code under test never sees the slope.)"""
+    rng = np.random.default_rng(132)
+    fall = rng.uniform(0.10, 0.25)
+    slope = -fall / 190.0
+    rig = rig_like(reference, rng).replace(
+        {"brake.gain_slope_wheel_speed_s_per_rad": slope}, "hidden law")
+    generate_campaign(tmp_path, rig, 132, RUNS)
+    result = diagnose(read_campaign(tmp_path).runs, reference)
+    assert result.verdict == "unexplained", result.verdict
+    trend = next(c for c in result.consistency if c.relation == "brake gain constant in speed")
+    assert trend.violated
+    low, high = (float(x) for x in trend.phase.split(" m/s")[0].split("–"))
+    radius = reference.number("wheel.unloaded_radius_m")
+    expected = slope * (high - low) / radius / (1 + slope * (high + low) / (2 * radius))
+    assert trend.deviation == pytest.approx(expected, rel=0.3)

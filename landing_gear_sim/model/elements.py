@@ -33,6 +33,8 @@ HAS_FADE = INDEX["elements.brake_fade"]
 RELAXATION = INDEX["tyre.relaxation_length_m"]
 FADE_FRACTION = INDEX["brake.fade_fraction"]
 FADE_ENERGY = INDEX["brake.fade_energy_j"]
+GAIN_SLOPE_SPEED = INDEX["brake.gain_slope_wheel_speed_s_per_rad"]
+GAIN_SLOPE_PRESSURE = INDEX["brake.gain_slope_pressure_per_pa"]
 FLY_RADIUS = INDEX["flywheel.radius_m"]
 FLY_INERTIA = INDEX["flywheel.inertia_kg_m2"]
 DRAG = INDEX["drag.coeff_n_s2_per_m2"]
@@ -108,15 +110,20 @@ def fade_factor(fade_fraction, brake_energy_j, fade_energy_j):
 
 
 @njit(cache=True)
-def brake_torque(p, pressure_pa, brake_energy_j):
+def brake_torque(p, pressure_pa, brake_energy_j, wheel_speed_rad_s):
     """Brake torque T_b = k_b P_b, eq. (8); a brake cannot push, so P_b < 0 gives 0.
 
-    With ``brake_fade`` the gain falls as the brake heats: k_b·:func:`fade_factor`.
+    With ``brake_fade`` the gain falls as the brake heats: k_b·:func:`fade_factor`. The
+    gain's slopes in wheel speed and pressure (0 on the reference rig) scale it by
+    1 + s_ω ω + s_P P (never below 0): terms outside the paper that a rig may have.
     """
     gain = p[BRAKE_GAIN]
     if p[HAS_FADE]:
         gain *= fade_factor(p[FADE_FRACTION], brake_energy_j, p[FADE_ENERGY])
-    return gain * max(pressure_pa, 0.0)
+    pressure = max(pressure_pa, 0.0)
+    gain *= max(1.0 + p[GAIN_SLOPE_SPEED] * wheel_speed_rad_s
+                + p[GAIN_SLOPE_PRESSURE] * pressure, 0.0)
+    return gain * pressure
 
 
 @njit(cache=True)

@@ -42,6 +42,8 @@ class ParamSpec:
     positive: bool = False  # strictly > 0 (else >= 0)
     signed: bool = False  # may be negative (an offset)
     choices: tuple[str, ...] = ()
+    default: float | None = None
+    """Value of a params file that lacks the key (terms added after files were written)."""
 
 
 def _f(key: str, unit: str, description: str, positive: bool = True) -> ParamSpec:
@@ -105,6 +107,14 @@ SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("sensors.pressure_offset_pa", "Pa",
               "pressure transducer offset (pressure_sensor_offset)", signed=True),
     _f("simulation.output_rate_hz", "Hz", "output (and input hold) rate"),
+    # new keys go last: the compiled physics caches each module with the indices it saw,
+    # and a module that did not change is not recompiled (shifted indices = wrong physics)
+    ParamSpec("brake.gain_slope_wheel_speed_s_per_rad", "s/rad",
+              "relative change of k_b per rad/s of wheel speed (a term the catalogue lacks; "
+              "0: none)", signed=True, default=0.0),
+    ParamSpec("brake.gain_slope_pressure_per_pa", "1/Pa",
+              "relative change of k_b per Pa of brake pressure (torque not linear in "
+              "pressure; 0: none)", signed=True, default=0.0),
 )
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}
@@ -239,6 +249,9 @@ def load_parameters(
             values[key] = _as_ros_reads_it(key, value)
             origin[key] = str(path)
     sources = tuple(str(p) for p in paths)
+    for spec in SPECS:
+        if spec.default is not None and spec.key not in values:
+            values[spec.key], origin[spec.key] = spec.default, "default"
     if overrides:
         _check_known(overrides, "--set")
         values.update(overrides)

@@ -64,7 +64,7 @@ def tyre_state(p, x, vertical_load_n):
 def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     """Write dx/dt of the plant state into ``dx`` (eqs. 1-8; rig or aircraft form)."""
     radius, hub, slip, fx = tyre_state(p, x, vertical_load_n)
-    tb = el.brake_torque(p, pressure_pa, x[E_BRAKE])
+    tb = el.brake_torque(p, pressure_pa, x[E_BRAKE], x[OMEGA])
     drag = el.drag_force(p, x[SPEED])
     mass = el.translational_mass(p)
     if p[el.HAS_GEAR_WALK] == 0.0:
@@ -155,7 +155,7 @@ def loading_step(p, xl, time_s, speed_m_s, step_s):
 def record(p, x, time_s, current_a, pressure_pa, load_n, row):
     """Fill one output row (see CHANNELS) from the state at ``time_s``."""
     radius, hub, slip, fx = tyre_state(p, x, load_n)
-    tb = el.brake_torque(p, pressure_pa, x[E_BRAKE])
+    tb = el.brake_torque(p, pressure_pa, x[E_BRAKE], x[OMEGA])
     omega_dot = el.wheel_acceleration(p, x[OMEGA], radius, fx, tb)
     row[0], row[1], row[2] = time_s, current_a, pressure_pa
     row[3], row[4], row[5] = x[OMEGA], x[SPEED], hub

@@ -28,6 +28,7 @@ setup(
         "matplotlib>=3.7",
         "PyYAML>=6.0",
         "rosbags>=0.11",
+        "scikit-learn>=1.3",
     ],
     extras_require={
         # ROS 2 Kilted from PyPI, for machines without a ROS install. Optional so that

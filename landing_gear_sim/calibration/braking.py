@@ -31,6 +31,7 @@ FILTER_HZ = 20.0  # zero-phase low-pass before differentiating speeds
 LOADED_N = 5e3  # the wheel is on the flywheel
 GAIN_UNIT = 1e-3  # the fade fit works with k_b in N m/kPa (order 1), torques in 100 N m
 TORQUE_UNIT_N_M = 100.0
+STEADY_RATE_RAD_S2 = 100.0  # a braked wheel decelerates at ~30 rad/s²; lock onsets far faster
 
 
 @dataclass(frozen=True)
@@ -158,6 +159,19 @@ def torque_balance(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray
     return torque, np.cumsum(power * dt)
 
 
+def braking_samples(b: Braking) -> np.ndarray:
+    """Samples where the torque balance measures the brake (mask (n,)): braking settled,
+    pressure over 3 bar, the wheel turning and loaded."""
+    return ((b.time_s > b.start_s + 0.2) & (b.pressure > 3 * PA_PER_BAR) & (b.wheel > 5.0)
+            & (b.load > LOADED_N))
+
+
+def steady_braking_samples(b: Braking) -> np.ndarray:
+    """:func:`braking_samples` away from wheel-lock transients (|ω̇| < STEADY_RATE_RAD_S2),
+    where the filtered derivative's error would dominate a local look at the gain."""
+    return braking_samples(b) & (np.abs(b.wheel_rate) < STEADY_RATE_RAD_S2)
+
+
 def fit_brake_gain(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
     """k_b from the wheel torque balance r F_x − J_w ω̇ = k_b P (least squares).
 
@@ -167,8 +181,7 @@ def fit_brake_gain(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
     torque, pressure, energy = [], [], []
     for b in runs:
         whole, absorbed = torque_balance(b, p)
-        m = ((b.time_s > b.start_s + 0.2) & (b.pressure > 3 * PA_PER_BAR) & (b.wheel > 5.0)
-             & (b.load > LOADED_N))
+        m = braking_samples(b)
         torque.append(whole[m])
         pressure.append(b.pressure[m])
         energy.append(absorbed[m])

@@ -18,6 +18,7 @@ from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field, replace
 
+from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.identify import Progress, identify
 from landing_gear_sim.calibration.measured import CHANNELS, simulate_all
 from landing_gear_sim.calibration.runs import ClassifiedRun, classify_all
@@ -34,6 +35,12 @@ from landing_gear_sim.diagnosis.consistency import (
     check_campaign,
     inconsistent,
     violations,
+)
+from landing_gear_sim.diagnosis.discovery import (
+    discovered_candidate,
+    families,
+    select_brake_terms,
+    term_formula,
 )
 from landing_gear_sim.diagnosis.findings import Finding, Signature
 from landing_gear_sim.diagnosis.identifiability import actuator_calibrated, untestable
@@ -149,6 +156,13 @@ def diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str] = 
         model, accepted = _recalibrate(runs, start, accepted, without)
         pending = [CATALOGUE[s.finding.cause] for s in scored
                    if s is not best and (s.finding.delta_bic or 0.0) < 0]
+    if not accepted:
+        found = _discover(runs, model, base, scales, before, say)
+        if found is not None:
+            table.append(found.finding)
+            if found.finding.accepted:
+                accepted.append(found)
+                model = found.fit.params
     say("analysing the residuals of the extended model")
     simulated_after = simulate_all(runs, model)
     after = _interpretable(find_signatures(runs, model, simulated_after), runs)
@@ -173,6 +187,29 @@ def diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str] = 
                 for sims in zip(runs, simulated_before, simulated_after, strict=True)]
     return Diagnosis(verdict, findings, table, baseline, start, calibrated, model,
                      before, after, problems, evidence, checks)
+
+
+def _discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: RigParameters,
+              scales: Scales, signatures: Sequence[Signature], say: Progress) -> Scored | None:
+    """A discovered brake-torque term, scored, when the brake-gain relations are violated
+    and the sparse regression keeps a term (None otherwise)."""
+    braking = [r for r in runs if r.braking]
+    broken = [c for c in violations(check_campaign(braking, model))
+              if c.relation.startswith("brake gain")]
+    if not broken:
+        return None
+    terms = select_brake_terms([br.prepare(r, model) for r in braking], model)
+    if not terms:
+        return None
+    candidate = discovered_candidate(terms)
+    say(f"fitting a discovered term: {families(candidate)}")
+    try:
+        scored = score_candidate(candidate, runs, model, datasheet, scales, signatures)
+    except IdentificationError:
+        return None
+    finding = replace(scored.finding, family=families(candidate),
+                      term=term_formula(candidate, scored.fit.params))
+    return Scored(finding, scored.fit)
 
 
 def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],

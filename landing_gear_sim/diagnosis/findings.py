@@ -44,13 +44,20 @@ class Finding:
     accepted: bool
     fitted_on: tuple[str, ...] = ()
     checked_on: tuple[str, ...] = ()
+    family: str = ""
+    """A ``discovered`` finding: the library family of its terms (``sliding_speed``, ...)."""
+    term: str = ""
+    """A ``discovered`` finding: the extended law with its fitted values."""
 
     def to_json(self) -> dict[str, object]:
-        return {"cause": self.cause, "parameters": self.parameters,
-                "uncertainty": self.std, "evidence": self.evidence,
-                "fit_before": self.fit_before, "fit_after": self.fit_after,
-                "delta_bic": self.delta_bic, "held_out_delta": self.held_out,
-                "fitted_on": list(self.fitted_on), "checked_on": list(self.checked_on)}
+        document: dict[str, object] = {"cause": self.cause, "parameters": self.parameters,
+                    "uncertainty": self.std, "evidence": self.evidence,
+                    "fit_before": self.fit_before, "fit_after": self.fit_after,
+                    "delta_bic": self.delta_bic, "held_out_delta": self.held_out,
+                    "fitted_on": list(self.fitted_on), "checked_on": list(self.checked_on)}
+        if self.family:
+            document |= {"family": self.family, "term": self.term}
+        return document
 
 
 @dataclass(frozen=True)

@@ -87,8 +87,9 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
     findings = html_table(
         ["cause", "parameters (SI) ± 1σ", "ΔBIC", "held-out Δ", "held-out fit before",
          "after", "evidence"],
-        [[f.cause, ", ".join(f"{k} = {v:.5g}" + (f" ± {f.std[k]:.2g}" if k in f.std else "")
-                             for k, v in f.parameters.items()),
+        [[f.cause + (f" ({f.family}): {f.term}" if f.term else ""),
+          ", ".join(f"{k} = {v:.5g}" + (f" ± {f.std[k]:.2g}" if k in f.std else "")
+                    for k, v in f.parameters.items()),
           _text(f.delta_bic), _text(f.held_out), fits(f.fit_before), fits(f.fit_after),
           f.evidence] for f in result.findings])
     candidates = html_table(
@@ -177,6 +178,8 @@ def diagnosis_summary(result: Diagnosis) -> str:
         values = ", ".join(f"{k} = {v:.6g}" + (f" ± {f.std[k]:.2g}" if k in f.std else "")
                            for k, v in f.parameters.items())
         lines.append(f"  {f.cause}: {values}")
+        if f.term:
+            lines.append(f"    {f.family}: {f.term}")
         if f.fit_after and f.fit_after != f.fit_before:
             gain = ", ".join(f"{c} {f.fit_before[c]:.2f} -> {f.fit_after[c]:.2f} %"
                              for c in f.fit_after)

@@ -28,11 +28,16 @@ from .run import Run
 STORAGE_SUFFIXES = (".mcap", ".db3")
 
 
+def storage_files(folder: Path) -> list[Path]:
+    """The rosbag2 storage files (``.mcap``, ``.db3``) directly in ``folder``, sorted."""
+    return sorted(p for p in folder.iterdir() if p.suffix.lower() in STORAGE_SUFFIXES)
+
+
 def bag_paths(path: Path) -> list[Path]:
     """What to open for ``path``: the bag folder, a ROS 1 ``.bag``, a storage file, or the
     storage files of a folder that lost its ``metadata.yaml``."""
     if path.is_dir() and not (path / "metadata.yaml").exists():
-        files = sorted(p for p in path.iterdir() if p.suffix.lower() in STORAGE_SUFFIXES)
+        files = storage_files(path)
         if not files:
             raise RunFormatError(f"{path}: not a bag (no metadata.yaml, no .mcap/.db3 file)")
         return files

@@ -31,7 +31,7 @@ def read_csv(path: Path, name: str | None = None, mapping: Mapping | None = None
 
     Raises:
         RunFormatError: missing file or column, non-numeric, NaN or implausible
-            values, time not strictly increasing, gaps; the message names the file.
+            values, time not strictly increasing; the message names the file.
     """
     path = Path(path)
     mapping = mapping or DEFAULT_MAPPING

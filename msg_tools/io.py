@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .bag_read import STORAGE_SUFFIXES, read_bag
+from .bag_read import STORAGE_SUFFIXES, read_bag, storage_files
 from .binary_tables import READERS
 from .columns import run_from_table
 from .csv_io import read_csv, run_name
@@ -37,7 +37,7 @@ def _lost_its_metadata(folder: Path) -> bool:
     """A bag folder without ``metadata.yaml``: one storage file, or rosbag2's segment
     names (``<folder>_0.mcap``, ``<folder>_1.mcap``); several other storage files are
     separate runs."""
-    files = [p for p in folder.iterdir() if p.suffix.lower() in STORAGE_SUFFIXES]
+    files = storage_files(folder)
     return len(files) == 1 or (len(files) > 1 and all(
         p.stem.rsplit("_", 1)[0] == folder.name for p in files))
 

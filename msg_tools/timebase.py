@@ -62,6 +62,12 @@ def fixed_rate_clock(time_s: np.ndarray) -> Clock | None:
     return Clock(float(start), float(period), index.astype(np.int64))
 
 
+def gap_text(time_s: np.ndarray, clock: Clock, row: int) -> str:
+    """The gap before ``row`` in words: how long, after which time."""
+    return (f"{clock.missing[row] * clock.period_s:.4g} s missing after "
+            f"t = {time_s[row - 1]:.6g} s")
+
+
 def on_clock(run: Run, clock: Clock) -> Run:
     """``run`` with its stamps replaced by the grid's instants (no sample moved)."""
     return dataclasses.replace(run, time_s=clock.times_s)
@@ -92,9 +98,8 @@ def split_at_gaps(run: Run) -> Split:
     cuts = np.flatnonzero(missing > MAX_INTERPOLATED_GAP)
     if not cuts.size:
         return Split((run,), tuple(notes))
-    for k in cuts:
-        notes.append(f"{run.name}: {missing[k] * clock.period_s:.4g} s missing after "
-                     f"t = {run.time_s[k - 1]:.6g} s; the run is split there")
+    notes.extend(f"{run.name}: {gap_text(run.time_s, clock, int(k))}; the run is split there"
+                 for k in cuts)
     parts = []
     for number, (lo, hi) in enumerate(zip([0, *cuts], [*cuts, len(run)], strict=True), 1):
         part = _part(run, lo, hi, number)

@@ -171,7 +171,8 @@ def test_identify_classifies_each_run_once(campaign_dir, reference, monkeypatch)
     classify again."""
     calls = []
     real = runs_module.classify
-    monkeypatch.setattr(runs_module, "classify", lambda run: calls.append(run.name) or real(run))
+    monkeypatch.setattr(runs_module, "classify",
+                        lambda run, *rest: calls.append(run.name) or real(run, *rest))
     runs = read_campaign(campaign_dir).runs
     identify(runs, reference, jackknife=False)
     assert sorted(calls) == sorted(r.name for r in runs)

@@ -16,7 +16,7 @@ from landing_gear_sim.calibration.runs import ClassifiedRun, classified
 from landing_gear_sim.model.integrate import SimulationResult, simulate
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s
-from landing_gear_sim.model.scenario import Scenario, denoised_command, logged_to_held
+from landing_gear_sim.model.scenario import Scenario, logged_to_held
 from msg_tools.run import Run
 
 CHANNELS: dict[str, str] = {
@@ -43,20 +43,9 @@ def scenario_for_run(run: ClassifiedRun, params: RigParameters) -> Scenario:
     initial = float(np.mean(rim_speed_m_s(params, run.flywheel_speed_rad_s[
         :INITIAL_SPEED_SAMPLES])))
     contact = run.braking
-    return Scenario(run.name, logged_to_held(command_estimate(run)), run.rate_hz, contact,
+    return Scenario(run.name, logged_to_held(run.command_a), run.rate_hz, contact,
                     initial if contact else 0.0, LOWEST_SIM_SPEED_M_S if contact else 0.0,
                     "measured input")
-
-
-def command_estimate(run: ClassifiedRun) -> np.ndarray:
-    """The brake command behind a braking run's logged current [A], shape (n,).
-
-    The valve was driven by the command, not by the logger's noise; fed to the model, that
-    noise is errors-in-variables within the valve's bandwidth, where wheel-lock events are
-    sensitive to it (:func:`~landing_gear_sim.model.scenario.denoised_command`). Actuator
-    runs (sweeps up to 100 Hz, which a median would flatten) are used as they are.
-    """
-    return denoised_command(run.current_a)[0] if run.braking else run.current_a
 
 
 def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult]:

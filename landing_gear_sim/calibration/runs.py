@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import functools
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
@@ -21,11 +22,11 @@ import numpy as np
 
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s
-from landing_gear_sim.model.scenario import brake_start_index, current_noise_a
+from landing_gear_sim.model.scenario import brake_start_index, current_noise_a, denoised_command
 from msg_tools.errors import RunFormatError
 from msg_tools.io import is_uniform, resample
 from msg_tools.run import Run
-from msg_tools.timebase import MAX_INTERPOLATED_GAP, fixed_rate_clock, on_clock
+from msg_tools.timebase import MAX_INTERPOLATED_GAP, fixed_rate_clock, gap_text, on_clock
 
 STILL_FLYWHEEL_RAD_S = 1.0  # an actuator-only run: the flywheel stands still ...
 NO_CONTACT_LOAD_N = 2e3  # ... and the wheel carries (almost) no load
@@ -98,11 +99,24 @@ class ClassifiedRun(Run):
         """``run`` on a uniform time base, classified."""
         run = on_uniform_grid(run)
         fields = {f.name: getattr(run, f.name) for f in dataclasses.fields(Run)}
-        return cls(**fields, kind=classify(run), brake_start_s=brake_start_s(run))
+        start = brake_start_s(run)
+        return cls(**fields, kind=classify(run, start), brake_start_s=start)
 
     @property
     def braking(self) -> bool:
         return self.kind.braking
+
+    @functools.cached_property
+    def command_a(self) -> np.ndarray:
+        """The brake command behind the logged current [A], shape (n,); computed once,
+        every simulation of the run feeds it.
+
+        The valve was driven by the command, not by the logger's noise; fed to the model,
+        that noise is errors-in-variables within the valve's bandwidth, where wheel-lock
+        events are sensitive to it (:func:`~landing_gear_sim.model.scenario.denoised_command`).
+        Actuator runs (sweeps up to 100 Hz, which a median would flatten) keep the log.
+        """
+        return denoised_command(self.current_a)[0] if self.braking else self.current_a
 
 
 def on_uniform_grid(run: Run) -> Run:
@@ -117,10 +131,9 @@ def on_uniform_grid(run: Run) -> Run:
         return resample(run, round(run.rate_hz))
     missing = clock.missing
     if missing.max() > MAX_INTERPOLATED_GAP:
-        k = int(np.argmax(missing))
-        raise RunFormatError(f"{run.name}: {missing[k] * clock.period_s:.4g} s missing after "
-                             f"t = {run.time_s[k - 1]:.6g} s, too long to interpolate; read "
-                             "it as part of a campaign to have it split there")
+        raise RunFormatError(f"{run.name}: {gap_text(run.time_s, clock, int(np.argmax(missing)))}"
+                             ", too long to interpolate; read it as part of a campaign to "
+                             "have it split there")
     run = on_clock(run, clock)
     return resample(run, 1.0 / clock.period_s) if missing.max() else run
 
@@ -140,14 +153,16 @@ def select(runs: Sequence[ClassifiedRun], selectors: Iterable[Selector]) -> list
     return [r for r in runs if matches(r.kind, chosen)]
 
 
-def classify(run: Run) -> RunKind:
+def classify(run: Run, brake_start: float | None = None) -> RunKind:
     """The kind of ``run`` from its signals: actuator-only (flywheel still, no load) as a
-    quasi-static ramp or dynamic; braking at constant or oscillating current."""
+    quasi-static ramp or dynamic; braking at constant or oscillating current
+    (``brake_start``: :func:`brake_start_s` of the run, if known already)."""
     if (np.max(run.flywheel_speed_rad_s) < STILL_FLYWHEEL_RAD_S
             and np.max(np.abs(run.vertical_load_n)) < NO_CONTACT_LOAD_N):
         ramp = _fastest_change_a_s(run) < RAMP_RATE_A_S and np.ptp(run.current_a) > RAMP_SPAN_A
         return RunKind.ACTUATOR_RAMP if ramp else RunKind.ACTUATOR_DYNAMIC
-    settled = run.time_s > brake_start_s(run) + SETTLE_S
+    start = brake_start_s(run) if brake_start is None else brake_start
+    settled = run.time_s > start + SETTLE_S
     limit = max(CONSTANT_STD_A, CONSTANT_NOISE_FACTOR * current_noise_a(run.current_a))
     if settled.sum() < 10 or np.std(run.current_a[settled]) < limit:
         return RunKind.BRAKE_CONSTANT

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from landing_gear_sim.calibration import braking as br
-from landing_gear_sim.calibration.runs import ClassifiedRun, RunKind
+from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.statistics import linear_std
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.scoring import effective_count
@@ -76,8 +76,10 @@ class Check:
 def check_campaign(runs: Sequence[ClassifiedRun], params: RigParameters) -> list[Check]:
     """Every check the runs allow, under ``params`` (radius law, wheel inertia, sensor
     offset of the calibrated model)."""
-    checks = [c for run in runs for c in _run_checks(run, params)]
-    braking = [br.prepare(r, params) for r in runs if r.braking]
+    prepared = [br.prepare(r, params) if r.braking else None for r in runs]
+    checks = [c for run, b in zip(runs, prepared, strict=True)
+              for c in _run_checks(run, b, params)]
+    braking = [b for b in prepared if b is not None]
     if braking:
         checks.extend(_gain_trends(braking, params))
     return checks
@@ -99,11 +101,13 @@ def inconsistent(broken: Sequence[Check]) -> Finding:
                    {}, {}, None, None, False, tuple(sorted({c.run for c in broken})), ())
 
 
-def _run_checks(run: ClassifiedRun, params: RigParameters) -> list[Check]:
+def _run_checks(run: ClassifiedRun, prepared: br.Braking | None, params: RigParameters
+                ) -> list[Check]:
+    """The checks of one run (``prepared``: its filtered signals, for a braking run)."""
     checks = [_zero_current(run, params)]
-    if run.braking:
-        checks.append(_free_rolling(br.prepare(run, params), params))
-    elif run.kind in (RunKind.ACTUATOR_RAMP, RunKind.ACTUATOR_DYNAMIC):
+    if prepared is not None:
+        checks.append(_free_rolling(prepared, params))
+    else:
         checks.extend(_mean_check("no contact ⇒ no load", run.name, "whole run",
                                   getattr(run, name), FORCE_FLOOR_N, "N", label)
                       for name, label in (("vertical_load_n", "F_z"),

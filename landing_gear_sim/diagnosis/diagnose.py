@@ -156,19 +156,20 @@ def diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str] = 
         model, accepted = _recalibrate(runs, start, accepted, without)
         pending = [CATALOGUE[s.finding.cause] for s in scored
                    if s is not best and (s.finding.delta_bic or 0.0) < 0]
+    say("checking the relations the rig measures twice")
+    checks = check_campaign(runs, model)
     if not accepted:
-        found = _discover(runs, model, base, scales, before, say)
+        found = _discover(runs, model, base, scales, before, checks, say)
         if found is not None:
             table.append(found.finding)
             if found.finding.accepted:
                 accepted.append(found)
                 model = found.fit.params
+                checks = check_campaign(runs, model)
     say("analysing the residuals of the extended model")
     simulated_after = simulate_all(runs, model)
     after = _interpretable(find_signatures(runs, model, simulated_after), runs)
     findings = [s.finding for s in accepted]
-    say("checking the relations the rig measures twice")
-    checks = check_campaign(runs, model)
     unchecked = _unchecked(table) if not accepted else []
     problems.extend(f"{f.cause} ({_in_words(f.parameters)}): fits the runs it was fitted on "
                     f"better (ΔBIC {f.delta_bic:+.0f}) but no run is left to check it on: too "
@@ -190,15 +191,14 @@ def diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str] = 
 
 
 def _discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: RigParameters,
-              scales: Scales, signatures: Sequence[Signature], say: Progress) -> Scored | None:
-    """A discovered brake-torque term, scored, when the brake-gain relations are violated
-    and the sparse regression keeps a term (None otherwise)."""
-    braking = [r for r in runs if r.braking]
-    broken = [c for c in violations(check_campaign(braking, model))
-              if c.relation.startswith("brake gain")]
-    if not broken:
+              scales: Scales, signatures: Sequence[Signature], checks: Sequence[Check],
+              say: Progress) -> Scored | None:
+    """A discovered brake-torque term, scored, when the brake-gain relations among
+    ``checks`` (of ``model``) are violated and the sparse regression keeps a term (None
+    otherwise)."""
+    if not any(c.relation.startswith("brake gain") for c in violations(checks)):
         return None
-    terms = select_brake_terms([br.prepare(r, model) for r in braking], model)
+    terms = select_brake_terms([br.prepare(r, model) for r in runs if r.braking], model)
     if not terms:
         return None
     candidate = discovered_candidate(terms)

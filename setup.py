@@ -29,6 +29,8 @@ setup(
         "PyYAML>=6.0",
         "rosbags>=0.11",
         "scikit-learn>=1.3",
+        "dask[distributed]>=2024.1",
+        "threadpoolctl>=3.1",
     ],
     extras_require={
         # ROS 2 Kilted from PyPI, for machines without a ROS install. Optional so that

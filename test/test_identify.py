@@ -345,3 +345,19 @@ def test_a_campaign_that_cannot_identify_everything_writes_only_when_asked(campa
                                           "friction curve"]
     assert any("drove ϑ3 to a factor 0.2" in p for p in evidence["problems"])
     assert load_parameters([out]).number("brake.gain_n_m_per_pa") > 0
+
+
+def test_a_friction_parameter_the_direct_fit_puts_on_zero_is_still_refined(tmp_path,
+                                                                          reference):
+    """Brakes 12 % weaker keep the stops at low slip: the direct fit put ϑ3 on its zero
+    bound (2.5e-10 ± 1e-24 for a rig with 0.145), and the multiplicative refinement kept it
+    there. Started from the prior instead, ϑ3 comes back with an honest σ."""
+    rig = rig_like(reference, np.random.default_rng(3))
+    rig = rig.replace({"brake.gain_n_m_per_pa": 0.88 * rig.number("brake.gain_n_m_per_pa")},
+                      "weak brakes")
+    generate_campaign(tmp_path, rig, seed=4)
+    estimates = {e.key: e for e in identify(read_campaign(tmp_path).runs, reference,
+                                            jackknife=False).estimates}
+    theta3 = estimates["friction.theta3"]
+    assert theta3.std > 0.05 * theta3.value
+    assert abs(theta3.value - rig.number("friction.theta3")) < 2 * theta3.std

@@ -27,15 +27,18 @@ from landing_gear_sim.calibration.actuator import (
     fit_actuator_dynamics,
     fit_static_map,
 )
+from landing_gear_sim.calibration.friction import KEYS as FRICTION_KEYS
 from landing_gear_sim.calibration.friction import fit_friction, refine_friction
 from landing_gear_sim.calibration.plausibility import check_units
 from landing_gear_sim.calibration.runs import ClassifiedRun, Family, RunKind, classify_all, select
 from landing_gear_sim.calibration.statistics import Estimate
 from landing_gear_sim.errors import IdentificationError, ParameterError
 from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.processes import single_threaded_blas
 from msg_tools.run import Run
 
 Progress = Callable[[str], None]
+ZERO_BOUND_FRACTION = 1e-3  # a direct-fit ϑ below this fraction of its prior sits on 0
 """Receives one line of progress at a time."""
 
 
@@ -104,6 +107,12 @@ def identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool = False,
     the friction estimate (its σ is then the residual-based one, and identify is ~4x
     faster).
     """
+    with single_threaded_blas():
+        return _identify(runs, base, fix_theta3, progress, friction, jackknife)
+
+
+def _identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool,
+              progress: Progress | None, friction: bool, jackknife: bool) -> Identification:
     state = _Calibration(base, progress or (lambda _msg: None))
     classified = classify_all(runs)
     check_units(classified, base)
@@ -144,11 +153,21 @@ def _braking_steps(state: _Calibration, runs: Sequence[ClassifiedRun], fix_theta
                    lambda: _friction_step(state, runs, prepared, fix_theta3, jackknife))
 
 
+def _refinement_start(direct: RigParameters, before: RigParameters) -> RigParameters:
+    """``direct`` with each ϑ the direct fit drove onto its zero bound back at its value
+    ``before``: the refinement scales its start, and 0 scaled stays 0 (stops that never
+    left low slip once gave ϑ3 = 2.5e-10 ± 1e-24 where the rig had 0.145)."""
+    stuck = {k: before.number(k) for k in FRICTION_KEYS
+             if direct.number(k) < ZERO_BOUND_FRACTION * before.number(k)}
+    return direct.replace(stuck, "refinement start") if stuck else direct
+
+
 def _friction_step(state: _Calibration, runs: Sequence[ClassifiedRun],
                    prepared: Sequence[br.Braking], fix_theta3: bool, jackknife: bool) -> None:
+    before = state.params
     state.adopt(fit_friction(prepared, state.params, fix_theta3))
     if not fix_theta3:
         state.say("refining the friction curve on the braking runs (output error)")
-        refined = refine_friction(runs, state.params, jackknife)
+        refined = refine_friction(runs, _refinement_start(state.params, before), jackknife)
         state.estimates[:] = [e for e in state.estimates if not e.key.startswith("friction.")]
         state.adopt(refined)

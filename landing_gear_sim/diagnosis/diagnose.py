@@ -22,6 +22,7 @@ from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.identify import Progress, identify
 from landing_gear_sim.calibration.measured import CHANNELS, simulate_all
 from landing_gear_sim.calibration.runs import ClassifiedRun, classify_all
+from landing_gear_sim.calibration.statistics import Estimate
 from landing_gear_sim.diagnosis.catalogue import (
     CATALOGUE,
     Candidate,
@@ -59,7 +60,7 @@ from landing_gear_sim.diagnosis.signatures import (
 )
 from landing_gear_sim.errors import DiagnosisError, IdentificationError
 from landing_gear_sim.model.parameters import ELEMENTS, RigParameters
-from landing_gear_sim.processes import pool_worker
+from landing_gear_sim.processes import pool_worker, single_threaded_blas
 from msg_tools.run import Run
 
 MAX_ROUNDS = 4
@@ -86,6 +87,8 @@ class Diagnosis:
     """Per run: the simulations compared and the residual spectrum (for the report)."""
     consistency: list[Check] = field(default_factory=list)
     """The relations the rig measures twice, checked under the extended model."""
+    estimates: tuple[Estimate, ...] = ()
+    """The starting model's calibration on the campaign: value and 1-σ per parameter."""
 
     def to_json(self) -> dict[str, object]:
         return {"verdict": self.verdict, "findings": [f.to_json() for f in self.findings],
@@ -116,6 +119,12 @@ def candidates_for(start: RigParameters, without: Sequence[str]) -> list[Candida
 def diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str] = (),
              progress: Progress | None = None) -> Diagnosis:
     """Calibrate, score the candidates, extend the model, report what remains."""
+    with single_threaded_blas():
+        return _diagnose(runs, base, without, progress)
+
+
+def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
+              progress: Progress | None) -> Diagnosis:
     say = progress or (lambda _msg: None)
     if not runs:
         raise DiagnosisError("no run to diagnose")
@@ -187,7 +196,7 @@ def diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str] = 
     evidence = [run_evidence(*sims, calibrated)
                 for sims in zip(runs, simulated_before, simulated_after, strict=True)]
     return Diagnosis(verdict, findings, table, baseline, start, calibrated, model,
-                     before, after, problems, evidence, checks)
+                     before, after, problems, evidence, checks, calibration.estimates)
 
 
 def _discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: RigParameters,
@@ -261,14 +270,17 @@ def _score_all(pending: Sequence[Candidate], runs: Sequence[ClassifiedRun], mode
     """Score the candidates, in parallel processes when there are cores to spare (each
     fit is independent and single-threaded); in order of ``pending``."""
     workers = min(len(pending), os.cpu_count() or 1)
-    if workers < 2:
+    if workers < 2 or multiprocessing.current_process().daemon:
+        # a daemonic process (a Dask worker's) may not have children
         return [_score_one(c, runs, model, datasheet, scales, signatures) for c in pending]
     # fork: the children inherit the compiled physics instead of compiling it again
     context = multiprocessing.get_context("fork")
     pool = ProcessPoolExecutor(workers, mp_context=context, initializer=pool_worker)
     try:
+        # the costliest first (more fitted parameters: more simulations per step), so the
+        # last to finish is a short one
         futures = {pool.submit(_score_one, c, runs, model, datasheet, scales, signatures): c
-                   for c in pending}
+                   for c in sorted(pending, key=lambda c: -len({*c.keys, *c.free}))}
         for future in as_completed(futures):
             say(f"  {futures[future].cause} scored")
         results = [next(f for f, c in futures.items() if c is candidate).result()

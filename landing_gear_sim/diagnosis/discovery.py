@@ -16,7 +16,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from sklearn.linear_model import LassoLarsIC
 
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
@@ -61,6 +60,9 @@ def select_brake_terms(runs: Sequence[br.Braking], params: RigParameters
     if y.size < 4 * len(BRAKE_LIBRARY):
         return {}
     spread = x.std(axis=0)
+    # imported here: scikit-learn costs ~1 s to import and most diagnoses never get here
+    from sklearn.linear_model import LassoLarsIC
+
     fit = LassoLarsIC(criterion="bic").fit((x - x.mean(axis=0)) / spread, y)
     coefficients = fit.coef_ / spread / np.mean(y)
     return {term: float(c) for term, c, span in zip(BRAKE_LIBRARY, coefficients, np.ptp(x, axis=0),

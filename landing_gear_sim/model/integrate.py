@@ -41,6 +41,9 @@ def run_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed,
     xl = np.zeros(1)
     work = np.zeros((5, N_STATES))
     pressure, load = 0.0, 0.0
+    # a wheel off the ground at rest is a fixed point of the plant (every derivative is
+    # exactly 0): stepping it only costs time (~80 % of an actuator run's simulation)
+    at_rest = not contact and initial_speed == 0.0
     n = current.shape[0]
     for k in range(n):
         t = k * step_s
@@ -51,7 +54,8 @@ def run_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed,
             break
         next_pressure = actuator_step(p, matrices, xa, current[k])
         next_load = loading_step(p, xl, t, x[SPEED], step_s) if contact else 0.0
-        plant_step(p, x, pressure, next_pressure, load, next_load, step_s, work)
+        if not at_rest:
+            plant_step(p, x, pressure, next_pressure, load, next_load, step_s, work)
         pressure, load = next_pressure, next_load
     return n, 0
 

@@ -153,13 +153,15 @@ def test_every_spec_has_a_unit_and_description():
     assert all(s.unit and s.description for s in SPECS)
 
 
-def test_a_params_file_written_before_the_gain_slopes_still_loads(tmp_path):
+def test_a_params_file_written_before_the_gain_slopes_and_crosstalk_still_loads(tmp_path):
     """Keys added to the schema later default to 'no such term' in older files."""
     from landing_gear_sim.model.parameters import default_config_files
 
     text = default_config_files()[0].read_text()
-    older = "\n".join(line for line in text.splitlines() if "gain_slope" not in line)
+    older = "\n".join(line for line in text.splitlines()
+                      if "gain_slope" not in line and "crosstalk" not in line)
     (tmp_path / "older.yaml").write_text(older + "\n")
     params = load_parameters([tmp_path / "older.yaml"])
     assert params.number("brake.gain_slope_wheel_speed_s_per_rad") == 0.0
     assert params.number("brake.gain_slope_pressure_per_pa") == 0.0
+    assert params.number("sensors.crosstalk_fx_per_fz") == 0.0

@@ -207,3 +207,25 @@ def test_aircraft_configuration_brakes_the_aircraft_mass(reference):
     assert plane.time_s[-1] == pytest.approx(rig.time_s[-1], rel=0.15)
     # the J_θ coupling of eqs. (5)-(6) changes the gear motion
     assert not np.allclose(plane.gear_angle_rad[:5000], rig.gear_angle_rad[:5000])
+
+
+def test_a_load_cell_with_crosstalk_reads_part_of_the_vertical_load(reference, run_30bar):
+    """sensors.crosstalk_fx_per_fz: the F_x channel reads F_x + c F_z (offline and in the
+    plant node's samples alike); the calibration takes it off again."""
+    from landing_gear_sim.model.blocks import PlantBlock
+    from landing_gear_sim.model.sensors import SensorModel
+
+    leaky = reference.replace({"sensors.crosstalk_fx_per_fz": 0.02}, "test")
+    read = simulate(leaky, run_30bar.scenario).to_run()
+    assert np.allclose(read.longitudinal_force_n,
+                       run_30bar.longitudinal_force_n + 0.02 * run_30bar.vertical_load_n)
+    sensors = SensorModel.of(leaky)
+    assert np.allclose(sensors.true_longitudinal(read.longitudinal_force_n,
+                                                 read.vertical_load_n),
+                       run_30bar.longitudinal_force_n)
+    block = PlantBlock(leaky, run_30bar.scenario)
+    for _ in range(1500):
+        block.advance(2e6, 1e5)
+    sample = block.sample()
+    row = block.record(0.0)
+    assert sample.longitudinal_force_n == pytest.approx(row[7] + 0.02 * row[6])

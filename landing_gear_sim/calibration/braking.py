@@ -63,13 +63,15 @@ def prepare(run: ClassifiedRun, p: RigParameters) -> Braking:
     """The filtered signals of a braking run under the parameter set ``p``."""
     rate = run.rate_hz
     wheel = lowpass(run.wheel_speed_rad_s, rate)
+    sensors = SensorModel.of(p)
     return Braking(
         run=run, time_s=run.time_s - run.time_s[0],
         speed_m_s=rim_speed_m_s(p, lowpass(run.flywheel_speed_rad_s, rate)),
         wheel=wheel, wheel_rate=np.gradient(wheel, 1.0 / rate),
-        pressure=lowpass(SensorModel.of(p).true_pressure(run.pressure_pa), rate),
+        pressure=lowpass(sensors.true_pressure(run.pressure_pa), rate),
         load=lowpass(run.vertical_load_n, rate),
-        force=lowpass(run.longitudinal_force_n, rate),
+        force=lowpass(sensors.true_longitudinal(run.longitudinal_force_n,
+                                                run.vertical_load_n), rate),
         start_s=run.brake_start_s - float(run.time_s[0]),
     )
 

@@ -40,6 +40,7 @@ PRESSURE_FLOOR_PA = 0.2 * PA_PER_BAR
 TREND_FLOOR = 0.05  # a brake gain changing by less than 5 % over the range does not matter
 SETTLED_S = 0.3  # after a current change the valve has settled
 MIN_SAMPLES = 200
+FREE_ROLLING = "free rolling ⇒ F_x = J_w ω̇ / r"
 
 
 @dataclass(frozen=True)
@@ -135,13 +136,21 @@ def _zero_current(run: ClassifiedRun, params: RigParameters) -> Check | None:
                        PRESSURE_FLOOR_PA, "Pa")
 
 
-def _free_rolling(b: br.Braking, params: RigParameters) -> Check | None:
-    """F_x before the brake acts, less the wheel's inertia force J_w ω̇ / r."""
+def free_rolling_excess(b: br.Braking, params: RigParameters) -> tuple[np.ndarray, np.ndarray]:
+    """The samples before the brake acts (mask), and the F_x there (the model's crosstalk
+    taken off the reading) less the wheel's inertia force J_w ω̇ / r [N]: what the load cell
+    reads beyond the physics."""
     m = br.free_rolling(b)
     radius = rolling_radius_at(params, b.load[m])
     inertia = params.number("wheel.inertia_kg_m2") * b.wheel_rate[m] / radius
-    return _mean_check("free rolling ⇒ F_x = J_w ω̇ / r", b.run.name, "before braking",
-                       b.run.longitudinal_force_n[m] - inertia, FORCE_FLOOR_N, "N")
+    force = SensorModel.of(params).true_longitudinal(b.run.longitudinal_force_n[m],
+                                                     b.run.vertical_load_n[m])
+    return m, force - inertia
+
+
+def _free_rolling(b: br.Braking, params: RigParameters) -> Check | None:
+    _, excess = free_rolling_excess(b, params)
+    return _mean_check(FREE_ROLLING, b.run.name, "before braking", excess, FORCE_FLOOR_N, "N")
 
 
 def _gain_trends(runs: Sequence[br.Braking], params: RigParameters) -> list[Check]:

@@ -32,15 +32,18 @@ from landing_gear_sim.diagnosis.catalogue import (
     switched_on,
 )
 from landing_gear_sim.diagnosis.consistency import (
+    FREE_ROLLING,
     Check,
     check_campaign,
     inconsistent,
     violations,
 )
 from landing_gear_sim.diagnosis.discovery import (
+    channel_candidate,
     discovered_candidate,
     families,
     select_brake_terms,
+    select_channel_terms,
     term_formula,
 )
 from landing_gear_sim.diagnosis.findings import Finding, Signature
@@ -202,15 +205,28 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
 def _discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: RigParameters,
               scales: Scales, signatures: Sequence[Signature], checks: Sequence[Check],
               say: Progress) -> Scored | None:
-    """A discovered brake-torque term, scored, when the brake-gain relations among
-    ``checks`` (of ``model``) are violated and the sparse regression keeps a term (None
-    otherwise)."""
-    if not any(c.relation.startswith("brake gain") for c in violations(checks)):
-        return None
-    terms = select_brake_terms([br.prepare(r, model) for r in runs if r.braking], model)
-    if not terms:
-        return None
-    candidate = discovered_candidate(terms)
+    """A discovered term, scored, when relations among ``checks`` (of ``model``) are
+    violated and the sparse regression keeps a term (None otherwise): a load-cell channel
+    first (what it misreads distorts the brake-gain relations too), then the brake torque."""
+    broken = {c.relation for c in violations(checks)}
+    scored = None
+    if FREE_ROLLING in broken:
+        channels = select_channel_terms(runs, model)
+        if channels:
+            scored = _score_discovered(channel_candidate(channels), runs, model, datasheet,
+                                       scales, signatures, say)
+    if (scored is None or not scored.finding.accepted) and any(
+            r.startswith("brake gain") for r in broken):
+        terms = select_brake_terms([br.prepare(r, model) for r in runs if r.braking], model)
+        if terms:
+            scored = _score_discovered(discovered_candidate(terms), runs, model, datasheet,
+                                       scales, signatures, say) or scored
+    return scored
+
+
+def _score_discovered(candidate: Candidate, runs: Sequence[ClassifiedRun],
+                      model: RigParameters, datasheet: RigParameters, scales: Scales,
+                      signatures: Sequence[Signature], say: Progress) -> Scored | None:
     say(f"fitting a discovered term: {families(candidate)}")
     try:
         scored = score_candidate(candidate, runs, model, datasheet, scales, signatures)

@@ -1,13 +1,16 @@
-"""Discovery of terms the catalogue lacks (issue 14, part 3, brake torque first).
+"""Discovery of terms the catalogue lacks (issue 14, part 3: brake torque, load-cell channels).
 
 When the brake-gain consistency checks are violated, the wheel's torque balance
 r F_x − J_w ω̇ = k_b P (1 + Σ c_i x_i) is regressed on a library of physical terms x_i
 with a sparse solver (scikit-learn's LARS lasso, its penalty chosen by BIC): the fewest terms
-that explain the gain's variation are kept. Each kept term fills the plant's slot for it
-(the brake gain's slopes), and the extension is scored exactly like a catalogue candidate:
-fitted with k_b and the friction curve it distorted, ΔBIC against the same re-fit without
-it, and the gain on held-out runs. A term that passes is reported as ``discovered`` with its
-family and its formula, never under a catalogue name.
+that explain the gain's variation are kept. When the free-rolling relation is violated, what
+the F_x channel reads where the true F_x is known (before braking: the wheel's inertia force;
+off the ground: 0) is regressed the same way on the other channels it may carry. Each kept
+term fills the model's slot for it (the brake gain's slopes, the sensors' crosstalk), and
+the extension is scored exactly like a catalogue candidate: fitted with the parameters it
+distorted, ΔBIC against the same re-fit without it, and the gain on held-out runs. A term
+that passes is reported as ``discovered`` with its family and its formula, never under a
+catalogue name.
 """
 
 from __future__ import annotations
@@ -18,7 +21,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
+from landing_gear_sim.diagnosis.consistency import FORCE_FLOOR_N, free_rolling_excess
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import PA_PER_BAR
 
@@ -70,6 +75,66 @@ def select_brake_terms(runs: Sequence[br.Braking], params: RigParameters
             if abs(c) * span > MIN_RELATIVE_EFFECT}
 
 
+@dataclass(frozen=True)
+class ChannelTerm:
+    """Another measured channel the F_x channel may carry, and the sensor slot that holds
+    the fraction."""
+
+    family: str
+    key: str
+    symbol: str
+    bound: float  # |fraction| admissible
+    values: Callable[[ClassifiedRun], np.ndarray]
+
+
+CHANNEL_LIBRARY = (
+    ChannelTerm("channel_crosstalk", "sensors.crosstalk_fx_per_fz", "F_z", 0.1,
+                lambda r: r.vertical_load_n),
+)
+
+
+def select_channel_terms(runs: Sequence[ClassifiedRun], params: RigParameters
+                         ) -> dict[ChannelTerm, float]:
+    """The channels the F_x channel carries, with their fractions, where the true F_x is
+    known: before braking and off the ground (sparse regression, BIC; kept when they move
+    F_x by more than the consistency floor)."""
+    excess, columns = [], []
+    for run in runs:
+        if run.braking:
+            mask, y = free_rolling_excess(br.prepare(run, params), params)
+        else:
+            mask, y = np.ones(len(run), dtype=bool), run.longitudinal_force_n
+        excess.append(y[::DECIMATE])
+        x = np.column_stack([t.values(run)[mask] for t in CHANNEL_LIBRARY])
+        columns.append(x[::DECIMATE])
+    y, x = np.concatenate(excess), np.vstack(columns)
+    if y.size < 4 * len(CHANNEL_LIBRARY):
+        return {}
+    from sklearn.linear_model import LassoLarsIC
+
+    spread = x.std(axis=0)
+    fit = LassoLarsIC(criterion="bic").fit((x - x.mean(axis=0)) / spread, y)
+    fractions = fit.coef_ / spread
+    return {term: float(c) for term, c, top in zip(CHANNEL_LIBRARY, fractions,
+                                                   np.max(np.abs(x), axis=0), strict=True)
+            if abs(c) * top > FORCE_FLOOR_N}
+
+
+def channel_candidate(terms: dict[ChannelTerm, float]) -> Candidate:
+    """The kept channel terms as a candidate: fitted with what a crosstalk distorts in the
+    calibration (the brake gain of the torque balance, the friction curve of μ = F_x/F_z,
+    the flywheel inertia and drag of its momentum balance: without the drag the fraction
+    came out 9 % high)."""
+    chosen = list(terms)
+    return Candidate(DISCOVERED, None, tuple(t.key for t in chosen),
+                     (tuple(terms[t] for t in chosen),),
+                     tuple((-t.bound, t.bound) for t in chosen),
+                     ("brake.gain_n_m_per_pa", "flywheel.inertia_kg_m2", "drag.coeff_n_s2_per_m2",
+                      *FRICTION),
+                     BRAKE_RUNS, (*WHEEL, "flywheel_speed_rad_s"), (),
+                     tuple((t.key.split(".")[1], t.key) for t in chosen))
+
+
 def discovered_candidate(terms: dict[LibraryTerm, float]) -> Candidate:
     """The kept terms as a candidate the scoring treats like a catalogue entry."""
     chosen = list(terms)
@@ -81,11 +146,18 @@ def discovered_candidate(terms: dict[LibraryTerm, float]) -> Candidate:
 
 
 def families(candidate: Candidate) -> str:
-    return "+".join(t.family for t in BRAKE_LIBRARY if t.key in candidate.keys)
+    return "+".join(t.family for t in (*BRAKE_LIBRARY, *CHANNEL_LIBRARY)
+                    if t.key in candidate.keys)
 
 
 def term_formula(candidate: Candidate, params: RigParameters) -> str:
-    """The extended law with its fitted values, e.g. ``T_b = k_b·P·(1 − 6.4e-04·ω)``."""
+    """The extended law with its fitted values, e.g. ``T_b = k_b·P·(1 − 6.4e-04·ω)`` or
+    ``F_x,read = F_x + 0.0123·F_z``."""
+    channels = [t for t in CHANNEL_LIBRARY if t.key in candidate.keys]
+    if channels:
+        values = [params.number(t.key) for t in channels]
+        return "F_x,read = F_x " + " ".join(f"{'+' if v >= 0 else '−'} {abs(v):.4g}·{t.symbol}"
+                                             for t, v in zip(channels, values, strict=True))
     parts = []
     for t in BRAKE_LIBRARY:
         if t.key in candidate.keys:

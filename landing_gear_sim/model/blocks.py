@@ -121,7 +121,7 @@ class PlantBlock:
             flywheel_speed_rad_s=float(sensors.speed(
                 quantities.flywheel_speed_rad_s(self._params, row[4]), rng)),
             vertical_load_n=float(sensors.force(row[6], rng)),
-            longitudinal_force_n=float(sensors.force(row[7], rng)))
+            longitudinal_force_n=float(sensors.longitudinal(row[7], row[6], rng)))
 
     def advance(self, next_pressure_pa: float, next_load_n: float) -> None:
         """Integrate to the next sample with inputs ramping to the given end values."""

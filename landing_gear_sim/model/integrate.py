@@ -126,7 +126,8 @@ class SimulationResult:
             flywheel_speed_rad_s=sensors.speed(flywheel_speed_rad_s(self.params, self.speed_m_s),
                                                rng),
             vertical_load_n=sensors.force(self.vertical_load_n, rng),
-            longitudinal_force_n=sensors.force(self.longitudinal_force_n, rng),
+            longitudinal_force_n=sensors.longitudinal(self.longitudinal_force_n,
+                                                      self.vertical_load_n, rng),
         )
 
 

@@ -115,6 +115,9 @@ SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("brake.gain_slope_pressure_per_pa", "1/Pa",
               "relative change of k_b per Pa of brake pressure (torque not linear in "
               "pressure; 0: none)", signed=True, default=0.0),
+    ParamSpec("sensors.crosstalk_fx_per_fz", "-",
+              "fraction of the vertical load the longitudinal load-cell channel reads "
+              "(a channel that is not clean; 0: none)", signed=True, default=0.0),
 )
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}

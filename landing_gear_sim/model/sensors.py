@@ -2,9 +2,11 @@
 
 Pressure transducer: the true gauge pressure plus ``sensors.pressure_offset_pa`` when the
 ``pressure_sensor_offset`` element is on, plus white noise. Encoders and the load cell:
-the true value plus white noise. Noise is drawn only when a random generator is given
-(``sensors.*_noise_*`` std; 0 means none), so a simulation compared with a measurement
-is never noisy by accident. Values are floats or arrays alike.
+the true value plus white noise; the load cell's longitudinal channel also reads
+``sensors.crosstalk_fx_per_fz`` of the vertical load (0 on a clean channel). Noise is
+drawn only when a random generator is given (``sensors.*_noise_*`` std; 0 means none), so a
+simulation compared with a measurement is never noisy by accident. Values are floats or
+arrays alike.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ class SensorModel:
     pressure_noise_pa: float = 0.0
     speed_noise_rad_s: float = 0.0
     force_noise_n: float = 0.0
+    fx_per_fz: float = 0.0
 
     @classmethod
     def of(cls, params: RigParameters) -> SensorModel:
@@ -33,7 +36,8 @@ class SensorModel:
                   if params.has("pressure_sensor_offset") else 0.0)
         return cls(offset, params.number("sensors.pressure_noise_pa"),
                    params.number("sensors.speed_noise_rad_s"),
-                   params.number("sensors.force_noise_n"))
+                   params.number("sensors.force_noise_n"),
+                   params.number("sensors.crosstalk_fx_per_fz"))
 
     def pressure(self, true_pa: Value, rng: np.random.Generator | None = None) -> Value:
         """Transducer reading [Pa, gauge] of the true brake pressure."""
@@ -46,6 +50,15 @@ class SensorModel:
     def force(self, true_n: Value, rng: np.random.Generator | None = None) -> Value:
         """Load-cell reading [N]."""
         return _noisy(true_n, self.force_noise_n, rng)
+
+    def longitudinal(self, true_fx_n: Value, true_fz_n: Value,
+                     rng: np.random.Generator | None = None) -> Value:
+        """Load-cell F_x channel reading [N]: F_x plus its crosstalk from F_z."""
+        return _noisy(true_fx_n + self.fx_per_fz * true_fz_n, self.force_noise_n, rng)
+
+    def true_longitudinal(self, reading_n: Value, vertical_n: Value) -> Value:
+        """The F_x behind a load-cell reading (its crosstalk from F_z removed) [N]."""
+        return reading_n - self.fx_per_fz * vertical_n
 
     def true_pressure(self, reading_pa: Value) -> Value:
         """The brake pressure behind a transducer reading (the offset removed) [Pa]."""

@@ -99,7 +99,8 @@ def client(scheduler: str | None = None, workers: int | None = None) -> Iterator
             yield connected
         return
     cluster = LocalCluster(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1,
-                           processes=True, host="127.0.0.1", dashboard_address=None,
+                           # a free port (8787 may be another cluster's), on 127.0.0.1
+                           processes=True, host="127.0.0.1", dashboard_address=":0",
                            silence_logs=logging.ERROR)
     with cluster, Client(cluster) as local:
         yield local

@@ -9,7 +9,8 @@ curve, the brake gain or the drag to swallow an effect the relations still show)
 * zero current ⇒ zero pressure (once the valve has settled);
 * no contact (actuator-only runs) ⇒ zero loads;
 * the brake gain of the wheel's torque balance r F_x − J_w ω̇ = k_b P does not depend on
-  the speed or on the pressure level (a local k_b, fitted with a linear trend).
+  the speed or on the pressure level (a local k_b, fitted with a linear trend), nor on the
+  run (k_b of each run, in the campaign's run order: wear, a brake that beds in).
 
 Each check is a deviation with its 1-σ from the residual's own noise (autocorrelation
 counted) and a physical floor below which nothing matters; violated when it exceeds both
@@ -40,7 +41,11 @@ PRESSURE_FLOOR_PA = 0.2 * PA_PER_BAR
 TREND_FLOOR = 0.05  # a brake gain changing by less than 5 % over the range does not matter
 SETTLED_S = 0.3  # after a current change the valve has settled
 MIN_SAMPLES = 200
+MIN_RUNS_FOR_DRIFT = 3
 FREE_ROLLING = "free rolling ⇒ F_x = J_w ω̇ / r"
+GAIN_IN_SPEED = "brake gain constant in speed"
+GAIN_IN_PRESSURE = "brake gain linear in pressure"
+RUN_DRIFT = "brake gain constant from run to run"
 
 
 @dataclass(frozen=True)
@@ -169,8 +174,39 @@ def _gain_trends(runs: Sequence[br.Braking], params: RigParameters) -> list[Chec
     t, p, v = (np.concatenate(x) for x in (torque, pressure, speed))
     if t.size < MIN_SAMPLES:
         return []
-    return [_trend("brake gain constant in speed", t, p, v, "m/s"),
-            _trend("brake gain linear in pressure", t, p, p / PA_PER_BAR, "bar")]
+    checks = [_trend(GAIN_IN_SPEED, t, p, v, "m/s"),
+              _trend(GAIN_IN_PRESSURE, t, p, p / PA_PER_BAR, "bar")]
+    per_run = [(tq, pr) for tq, pr in zip(torque, pressure, strict=True)
+               if tq.size >= MIN_SAMPLES // 10]
+    if len(per_run) >= MIN_RUNS_FOR_DRIFT:
+        checks.append(_run_drift(per_run))
+    return checks
+
+
+def _run_drift(per_run: Sequence[tuple[np.ndarray, np.ndarray]]) -> Check:
+    """k_b of each run (T = k_b P, its 1-σ from the run's own residual), then a straight line
+    through them in run order: the relative change from the first run to the last [1]. The
+    σ are scaled up to the scatter about the line when that is larger (model errors that
+    differ from run to run are not wear)."""
+    gains, std = [], []
+    for torque, pressure in per_run:
+        design = pressure[:, None]
+        coef, *_ = np.linalg.lstsq(design, torque, rcond=None)
+        gains.append(coef[0])
+        std.append(linear_std(design, torque - design @ coef, 1)[0])
+    k, s = np.array(gains), np.array(std)
+    order = np.arange(k.size, dtype=float)
+    weights = 1.0 / np.maximum(s, 1e-9 * np.mean(np.abs(k))) ** 2
+    line = np.polyfit(order, k, 1, w=np.sqrt(weights), cov="unscaled")
+    (slope, _), covariance = line
+    chi2 = float(np.sum(weights * (k - np.polyval(line[0], order)) ** 2))
+    inflation = max(1.0, chi2 / max(k.size - 2, 1))
+    mean = float(np.average(k, weights=weights))
+    span = k.size - 1
+    return Check(RUN_DRIFT, "campaign", f"{k.size} runs in order",
+                 float(slope * span / mean),
+                 float(np.sqrt(covariance[0, 0] * inflation) * span / abs(mean)), TREND_FLOOR,
+                 "of k_b")
 
 
 def _trend(relation: str, torque: np.ndarray, pressure: np.ndarray, variable: np.ndarray,

@@ -33,6 +33,8 @@ from landing_gear_sim.diagnosis.catalogue import (
 )
 from landing_gear_sim.diagnosis.consistency import (
     FREE_ROLLING,
+    GAIN_IN_PRESSURE,
+    GAIN_IN_SPEED,
     Check,
     check_campaign,
     inconsistent,
@@ -215,8 +217,9 @@ def _discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: Ri
         if channels:
             scored = _score_discovered(channel_candidate(channels), runs, model, datasheet,
                                        scales, signatures, say)
-    if (scored is None or not scored.finding.accepted) and any(
-            r.startswith("brake gain") for r in broken):
+    # the gain's law in speed and pressure (a drift from run to run has no term yet)
+    if (scored is None or not scored.finding.accepted) and broken & {GAIN_IN_SPEED,
+                                                                     GAIN_IN_PRESSURE}:
         terms = select_brake_terms([br.prepare(r, model) for r in runs if r.braking], model)
         if terms:
             scored = _score_discovered(discovered_candidate(terms), runs, model, datasheet,

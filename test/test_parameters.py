@@ -158,10 +158,11 @@ def test_a_params_file_written_before_the_gain_slopes_and_crosstalk_still_loads(
     from landing_gear_sim.model.parameters import default_config_files
 
     text = default_config_files()[0].read_text()
-    older = "\n".join(line for line in text.splitlines()
-                      if "gain_slope" not in line and "crosstalk" not in line)
+    later = ("gain_slope", "crosstalk", "wheel_speed_delay")
+    older = "\n".join(line for line in text.splitlines() if not any(k in line for k in later))
     (tmp_path / "older.yaml").write_text(older + "\n")
     params = load_parameters([tmp_path / "older.yaml"])
     assert params.number("brake.gain_slope_wheel_speed_s_per_rad") == 0.0
     assert params.number("brake.gain_slope_pressure_per_pa") == 0.0
     assert params.number("sensors.crosstalk_fx_per_fz") == 0.0
+    assert params.number("sensors.wheel_speed_delay_s") == 0.0

@@ -229,3 +229,24 @@ def test_a_load_cell_with_crosstalk_reads_part_of_the_vertical_load(reference, r
     sample = block.sample()
     row = block.record(0.0)
     assert sample.longitudinal_force_n == pytest.approx(row[7] + 0.02 * row[6])
+
+
+def test_a_wheel_channel_out_of_step_reads_the_same_offline_and_in_the_node(reference,
+                                                                           run_30bar):
+    """sensors.wheel_speed_delay_s: the wheel channel reads ω(t − d), the same value from the
+    plant node's recent samples as from the whole offline run."""
+    from landing_gear_sim.model.blocks import PlantBlock
+
+    late = reference.replace({"sensors.wheel_speed_delay_s": 0.0205}, "test")
+    offline = simulate(late, run_30bar.scenario).to_run()
+    truth = run_30bar.wheel_speed_rad_s
+    assert np.allclose(offline.wheel_speed_rad_s[:21], truth[0])
+    assert np.allclose(offline.wheel_speed_rad_s[100:],
+                       0.5 * (truth[79:-21] + truth[80:-20]))
+    block = PlantBlock(late, run_30bar.scenario)
+    readings = []
+    for _ in range(3000):
+        readings.append(block.sample().wheel_speed_rad_s)
+        block.advance(run_30bar.pressure_pa[block.step_index + 1],
+                      run_30bar.vertical_load_n[block.step_index + 1])
+    assert np.array_equal(readings, offline.wheel_speed_rad_s[:3000])

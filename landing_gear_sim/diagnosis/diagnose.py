@@ -46,9 +46,10 @@ from landing_gear_sim.diagnosis.discovery import (
     families,
     select_brake_terms,
     select_channel_terms,
+    skew_candidate,
     term_formula,
 )
-from landing_gear_sim.diagnosis.findings import Finding, Signature
+from landing_gear_sim.diagnosis.findings import Finding, Signature, SignatureKind
 from landing_gear_sim.diagnosis.identifiability import actuator_calibrated, untestable
 from landing_gear_sim.diagnosis.scoring import (
     BIC_THRESHOLD,
@@ -208,11 +209,17 @@ def _discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: Ri
               scales: Scales, signatures: Sequence[Signature], checks: Sequence[Check],
               say: Progress) -> Scored | None:
     """A discovered term, scored, when relations among ``checks`` (of ``model``) are
-    violated and the sparse regression keeps a term (None otherwise): a load-cell channel
-    first (what it misreads distorts the brake-gain relations too), then the brake torque."""
+    violated and the sparse regression keeps a term, or the wheel channel lags the model
+    (None otherwise): the channels first (what they misread distorts the brake-gain
+    relations too), then the brake torque."""
     broken = {c.relation for c in violations(checks)}
     scored = None
-    if FREE_ROLLING in broken:
+    lags = [s.value for s in signatures if s.kind is SignatureKind.LAG
+            and s.channel == "wheel_speed_rad_s" and s.value > 0]
+    if lags:
+        scored = _score_discovered(skew_candidate(lags[0]), runs, model, datasheet, scales,
+                                   signatures, say)
+    if FREE_ROLLING in broken and (scored is None or not scored.finding.accepted):
         channels = select_channel_terms(runs, model)
         if channels:
             scored = _score_discovered(channel_candidate(channels), runs, model, datasheet,

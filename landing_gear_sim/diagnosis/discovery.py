@@ -135,6 +135,17 @@ def channel_candidate(terms: dict[ChannelTerm, float]) -> Candidate:
                      tuple((t.key.split(".")[1], t.key) for t in chosen))
 
 
+SKEW_KEY = "sensors.wheel_speed_delay_s"
+SKEW_BOUNDS = (0.0, 0.2)  # s
+
+
+def skew_candidate(lag_s: float) -> Candidate:
+    """The wheel channel out of step by ``lag_s`` (the residual's consistent lag) as a
+    candidate: fitted with the friction curve (slip read from a late wheel bent it)."""
+    return Candidate(DISCOVERED, None, (SKEW_KEY,), ((lag_s,),), (SKEW_BOUNDS,), FRICTION,
+                     BRAKE_RUNS, WHEEL, (), (("wheel_speed_delay_s", SKEW_KEY),))
+
+
 def discovered_candidate(terms: dict[LibraryTerm, float]) -> Candidate:
     """The kept terms as a candidate the scoring treats like a catalogue entry."""
     chosen = list(terms)
@@ -146,6 +157,8 @@ def discovered_candidate(terms: dict[LibraryTerm, float]) -> Candidate:
 
 
 def families(candidate: Candidate) -> str:
+    if SKEW_KEY in candidate.keys:
+        return "channel_skew"
     return "+".join(t.family for t in (*BRAKE_LIBRARY, *CHANNEL_LIBRARY)
                     if t.key in candidate.keys)
 
@@ -153,6 +166,8 @@ def families(candidate: Candidate) -> str:
 def term_formula(candidate: Candidate, params: RigParameters) -> str:
     """The extended law with its fitted values, e.g. ``T_b = k_b·P·(1 − 6.4e-04·ω)`` or
     ``F_x,read = F_x + 0.0123·F_z``."""
+    if SKEW_KEY in candidate.keys:
+        return f"ω_read(t) = ω(t − {1e3 * params.number(SKEW_KEY):.1f} ms)"
     channels = [t for t in CHANNEL_LIBRARY if t.key in candidate.keys]
     if channels:
         values = [params.number(t.key) for t in channels]

@@ -7,6 +7,8 @@ calls, so a graph run and an offline run of the same inputs agree. No ROS here.
 
 from __future__ import annotations
 
+import math
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -85,6 +87,9 @@ class PlantBlock:
         self._row = np.empty(plant.N_CHANNELS)
         self._params = params
         self._sensors = SensorModel.of(params)
+        # the wheel channel out of step reads this many recent samples (none when in step)
+        kept = math.ceil(self._sensors.wheel_delay_s / scenario.step_s) + 2
+        self._wheel_history: deque[tuple[float, float]] = deque(maxlen=max(kept, 1))
         self.step_index = 0
         self.pressure_pa = 0.0
         self.load_n = 0.0
@@ -117,11 +122,20 @@ class PlantBlock:
         return SensorSample(
             step=self.step_index, time_s=float(row[0]),
             pressure_pa=float(sensors.pressure(row[2], rng)),
-            wheel_speed_rad_s=float(sensors.speed(row[3], rng)),
+            wheel_speed_rad_s=float(sensors.speed(self._wheel_read(row[0], row[3]), rng)),
             flywheel_speed_rad_s=float(sensors.speed(
                 quantities.flywheel_speed_rad_s(self._params, row[4]), rng)),
             vertical_load_n=float(sensors.force(row[6], rng)),
             longitudinal_force_n=float(sensors.longitudinal(row[7], row[6], rng)))
+
+    def _wheel_read(self, time_s: float, wheel_rad_s: float) -> float:
+        """The wheel channel's noise-free reading now (out of step: from recent samples)."""
+        if self._sensors.wheel_delay_s <= 0.0:
+            return wheel_rad_s
+        if not self._wheel_history or self._wheel_history[-1][0] < time_s:
+            self._wheel_history.append((time_s, wheel_rad_s))
+        times, wheel = (np.array(column) for column in zip(*self._wheel_history, strict=True))
+        return float(self._sensors.out_of_step(times, wheel)[-1])
 
     def advance(self, next_pressure_pa: float, next_load_n: float) -> None:
         """Integrate to the next sample with inputs ramping to the given end values."""

@@ -122,7 +122,7 @@ class SimulationResult:
             name=self.scenario.name, source="simulation", time_s=self.time_s.copy(),
             current_a=held_to_logged(self.current_a),
             pressure_pa=sensors.pressure(self.pressure_pa, rng),
-            wheel_speed_rad_s=sensors.speed(self.wheel_speed_rad_s, rng),
+            wheel_speed_rad_s=sensors.wheel_speed(self.time_s, self.wheel_speed_rad_s, rng),
             flywheel_speed_rad_s=sensors.speed(flywheel_speed_rad_s(self.params, self.speed_m_s),
                                                rng),
             vertical_load_n=sensors.force(self.vertical_load_n, rng),

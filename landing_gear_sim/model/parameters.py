@@ -118,6 +118,9 @@ SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("sensors.crosstalk_fx_per_fz", "-",
               "fraction of the vertical load the longitudinal load-cell channel reads "
               "(a channel that is not clean; 0: none)", signed=True, default=0.0),
+    ParamSpec("sensors.wheel_speed_delay_s", "s",
+              "the wheel-speed channel reads the wheel this much earlier than the others are "
+              "read (a logger channel out of step; 0: none)", default=0.0),
 )
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}

@@ -3,7 +3,9 @@
 Pressure transducer: the true gauge pressure plus ``sensors.pressure_offset_pa`` when the
 ``pressure_sensor_offset`` element is on, plus white noise. Encoders and the load cell:
 the true value plus white noise; the load cell's longitudinal channel also reads
-``sensors.crosstalk_fx_per_fz`` of the vertical load (0 on a clean channel). Noise is
+``sensors.crosstalk_fx_per_fz`` of the vertical load (0 on a clean channel), and the wheel
+encoder's channel may be ``sensors.wheel_speed_delay_s`` out of step with the others (it
+reads the wheel speed that much earlier, linearly interpolated; 0: in step). Noise is
 drawn only when a random generator is given (``sensors.*_noise_*`` std; 0 means none), so a
 simulation compared with a measurement is never noisy by accident. Values are floats or
 arrays alike.
@@ -29,6 +31,7 @@ class SensorModel:
     speed_noise_rad_s: float = 0.0
     force_noise_n: float = 0.0
     fx_per_fz: float = 0.0
+    wheel_delay_s: float = 0.0
 
     @classmethod
     def of(cls, params: RigParameters) -> SensorModel:
@@ -37,7 +40,8 @@ class SensorModel:
         return cls(offset, params.number("sensors.pressure_noise_pa"),
                    params.number("sensors.speed_noise_rad_s"),
                    params.number("sensors.force_noise_n"),
-                   params.number("sensors.crosstalk_fx_per_fz"))
+                   params.number("sensors.crosstalk_fx_per_fz"),
+                   params.number("sensors.wheel_speed_delay_s"))
 
     def pressure(self, true_pa: Value, rng: np.random.Generator | None = None) -> Value:
         """Transducer reading [Pa, gauge] of the true brake pressure."""
@@ -50,6 +54,20 @@ class SensorModel:
     def force(self, true_n: Value, rng: np.random.Generator | None = None) -> Value:
         """Load-cell reading [N]."""
         return _noisy(true_n, self.force_noise_n, rng)
+
+    def wheel_speed(self, times_s: np.ndarray, true_rad_s: np.ndarray,
+                    rng: np.random.Generator | None = None) -> np.ndarray:
+        """Wheel-encoder channel [rad/s] of the samples at ``times_s`` (s, increasing; shape
+        of ``true_rad_s``)."""
+        return _noisy(self.out_of_step(times_s, true_rad_s), self.speed_noise_rad_s, rng)
+
+    def out_of_step(self, times_s: np.ndarray, true_rad_s: np.ndarray) -> np.ndarray:
+        """The wheel speed ``wheel_delay_s`` before each of ``times_s`` (the first sample's
+        before the start), noise-free. Element k needs only the samples from
+        ``times_s[k] − wheel_delay_s`` on: the plant node passes its recent history."""
+        if self.wheel_delay_s <= 0.0:
+            return true_rad_s
+        return np.interp(times_s - self.wheel_delay_s, times_s, true_rad_s)
 
     def longitudinal(self, true_fx_n: Value, true_fz_n: Value,
                      rng: np.random.Generator | None = None) -> Value:

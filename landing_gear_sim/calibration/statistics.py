@@ -55,6 +55,23 @@ def linear_std(design: np.ndarray, residual: np.ndarray, n_params: int) -> np.nd
     return np.sqrt(np.clip(np.diag(cov), 0.0, None))
 
 
+def inverse_variance_weights(values: np.ndarray, std: np.ndarray) -> np.ndarray:
+    """1/σ² of each value; a σ of 0 (a value held fixed) is floored at 1e-9 of the values'
+    scale, so it cannot weigh infinitely."""
+    scale = float(np.mean(np.abs(values))) or 1.0
+    return 1.0 / np.maximum(std, 1e-9 * scale) ** 2
+
+
+def weighted_least_squares(design: np.ndarray, y: np.ndarray, weights: np.ndarray
+                           ) -> tuple[np.ndarray, np.ndarray, float]:
+    """y ≈ design β with weights 1/σ² (design (n, k), y and weights (n,)): β, its covariance
+    for the σ as given, and χ² of the fit."""
+    root = np.sqrt(weights)
+    beta, *_ = np.linalg.lstsq(design * root[:, None], y * root, rcond=None)
+    covariance = np.linalg.pinv((design * weights[:, None]).T @ design)
+    return beta, covariance, float(np.sum(weights * (y - design @ beta) ** 2))
+
+
 def run_weights(lengths: Sequence[int]) -> np.ndarray:
     """Weight on each run's residuals so that no run counts for more than a run of the
     median length, shape (len(lengths),): a 5-minute stop beside 10-s runs would otherwise

@@ -23,6 +23,10 @@ import numpy as np
 import scipy.stats
 
 from landing_gear_sim.calibration.identify import identify
+from landing_gear_sim.calibration.statistics import (
+    inverse_variance_weights,
+    weighted_least_squares,
+)
 from landing_gear_sim.errors import LandingGearSimError
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.io import campaign_sources, read_campaign
@@ -104,26 +108,16 @@ class _Fit:
     at: int = 0
 
 
-def _weighted_fit(x: np.ndarray, y: np.ndarray, w: np.ndarray) -> tuple[np.ndarray,
-                                                                      np.ndarray, float]:
-    """Weighted least squares y ≈ x β: β, its covariance (σ as given), χ²."""
-    sw = np.sqrt(w)
-    beta, *_ = np.linalg.lstsq(x * sw[:, None], y * sw, rcond=None)
-    covariance = np.linalg.pinv((x * w[:, None]).T @ x)
-    chi2 = float(np.sum(w * (y - x @ beta) ** 2))
-    return beta, covariance, chi2
-
-
 def _candidates(y: np.ndarray, w: np.ndarray) -> list[_Fit]:
     n = len(y)
     ones = np.ones(n)
-    _, _, chi2 = _weighted_fit(ones[:, None], y, w)
+    _, _, chi2 = weighted_least_squares(ones[:, None], y, w)
     fits = [_Fit(chi2, 1, 0.0, 1.0)]
-    beta, cov, chi2 = _weighted_fit(np.column_stack([ones, np.arange(n)]), y, w)
+    beta, cov, chi2 = weighted_least_squares(np.column_stack([ones, np.arange(n)]), y, w)
     fits.append(_Fit(chi2, 2, beta[1], math.sqrt(cov[1, 1])))
     for at in range(MIN_SIDE, n - MIN_SIDE + 1):
         after = (np.arange(n) >= at).astype(float)
-        beta, cov, chi2 = _weighted_fit(np.column_stack([ones, after]), y, w)
+        beta, cov, chi2 = weighted_least_squares(np.column_stack([ones, after]), y, w)
         fits.append(_Fit(chi2, 3, beta[1], math.sqrt(cov[1, 1]), at))
     return fits
 
@@ -133,8 +127,7 @@ def parameter_change(key: str, campaigns: Sequence[str], values: np.ndarray,
     """The trend or step of one parameter over ``campaigns`` (time order), or None."""
     if len(values) < MIN_CAMPAIGNS:
         return None
-    scale = float(np.mean(np.abs(values))) or 1.0
-    w = 1.0 / np.maximum(std, 1e-9 * scale) ** 2
+    w = inverse_variance_weights(values, std)
     fits = _candidates(values, w)
     n = len(values)
     best = min(fits, key=lambda f: f.chi2 + f.k * math.log(n))
@@ -153,7 +146,8 @@ def parameter_change(key: str, campaigns: Sequence[str], values: np.ndarray,
     if gain < BIC_MARGIN or z < critical:
         return None
     reference = abs(float(np.average(values[:best.at] if best.at else values,
-                                     weights=w[:best.at] if best.at else w))) or scale
+                                     weights=w[:best.at] if best.at else w))) \
+        or float(np.mean(np.abs(values))) or 1.0
     kind = "trend" if best.k == 2 else "step"
     return Change(key, kind, best.size / reference, z, campaigns[best.at] if best.at else "")
 

@@ -27,7 +27,11 @@ import numpy as np
 
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun
-from landing_gear_sim.calibration.statistics import linear_std
+from landing_gear_sim.calibration.statistics import (
+    inverse_variance_weights,
+    linear_std,
+    weighted_least_squares,
+)
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.scoring import effective_count
 from landing_gear_sim.model.parameters import RigParameters
@@ -194,18 +198,16 @@ def _run_drift(per_run: Sequence[tuple[np.ndarray, np.ndarray]]) -> Check:
         coef, *_ = np.linalg.lstsq(design, torque, rcond=None)
         gains.append(coef[0])
         std.append(linear_std(design, torque - design @ coef, 1)[0])
-    k, s = np.array(gains), np.array(std)
-    order = np.arange(k.size, dtype=float)
-    weights = 1.0 / np.maximum(s, 1e-9 * np.mean(np.abs(k))) ** 2
-    line = np.polyfit(order, k, 1, w=np.sqrt(weights), cov="unscaled")
-    (slope, _), covariance = line
-    chi2 = float(np.sum(weights * (k - np.polyval(line[0], order)) ** 2))
+    k = np.array(gains)
+    weights = inverse_variance_weights(k, np.array(std))
+    design = np.column_stack([np.ones(k.size), np.arange(k.size)])
+    (_, slope), covariance, chi2 = weighted_least_squares(design, k, weights)
     inflation = max(1.0, chi2 / max(k.size - 2, 1))
     mean = float(np.average(k, weights=weights))
     span = k.size - 1
     return Check(RUN_DRIFT, "campaign", f"{k.size} runs in order",
                  float(slope * span / mean),
-                 float(np.sqrt(covariance[0, 0] * inflation) * span / abs(mean)), TREND_FLOOR,
+                 float(np.sqrt(covariance[1, 1] * inflation) * span / abs(mean)), TREND_FLOOR,
                  "of k_b")
 
 

@@ -219,15 +219,16 @@ def _discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: Ri
     if lags:
         scored = _score_discovered(skew_candidate(lags[0]), runs, model, datasheet, scales,
                                    signatures, say)
+    braking = [br.prepare(r, model) for r in runs if r.braking]
     if FREE_ROLLING in broken and (scored is None or not scored.finding.accepted):
-        channels = select_channel_terms(runs, model)
+        channels = select_channel_terms(runs, braking, model)
         if channels:
             scored = _score_discovered(channel_candidate(channels), runs, model, datasheet,
                                        scales, signatures, say)
     # the gain's law in speed and pressure (a drift from run to run has no term yet)
     if (scored is None or not scored.finding.accepted) and broken & {GAIN_IN_SPEED,
                                                                      GAIN_IN_PRESSURE}:
-        terms = select_brake_terms([br.prepare(r, model) for r in runs if r.braking], model)
+        terms = select_brake_terms(braking, model)
         if terms:
             scored = _score_discovered(discovered_candidate(terms), runs, model, datasheet,
                                        scales, signatures, say) or scored

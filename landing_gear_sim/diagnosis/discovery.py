@@ -15,8 +15,9 @@ catalogue name.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 
@@ -33,13 +34,23 @@ MIN_RELATIVE_EFFECT = 0.02  # a term changing the gain by less over its range is
 
 
 @dataclass(frozen=True)
-class LibraryTerm:
-    """A physical term the brake gain may depend on, and the plant slot that holds it."""
+class Term:
+    """A term of a library: its family, the model slot that holds its coefficient, its
+    symbol in the formula, and the coefficient's admissible magnitude."""
 
     family: str
     key: str
     symbol: str
-    bound: float  # |coefficient| admissible [1/unit of x]
+    bound: float  # |coefficient| admissible [1/unit of the term]
+
+
+TermT = TypeVar("TermT", bound=Term)
+
+
+@dataclass(frozen=True)
+class LibraryTerm(Term):
+    """A physical term the brake gain may depend on."""
+
     values: Callable[[br.Braking], np.ndarray]
 
 
@@ -64,26 +75,27 @@ def select_brake_terms(runs: Sequence[br.Braking], params: RigParameters
     y, x = np.concatenate(ratio), np.vstack(columns)
     if y.size < 4 * len(BRAKE_LIBRARY):
         return {}
-    spread = x.std(axis=0)
-    # imported here: scikit-learn costs ~1 s to import and most diagnoses never get here
-    from sklearn.linear_model import LassoLarsIC
-
-    fit = LassoLarsIC(criterion="bic").fit((x - x.mean(axis=0)) / spread, y)
-    coefficients = fit.coef_ / spread / np.mean(y)
+    coefficients = sparse_coefficients(x, y) / np.mean(y)
     return {term: float(c) for term, c, span in zip(BRAKE_LIBRARY, coefficients, np.ptp(x, axis=0),
                                                      strict=True)
             if abs(c) * span > MIN_RELATIVE_EFFECT}
 
 
-@dataclass(frozen=True)
-class ChannelTerm:
-    """Another measured channel the F_x channel may carry, and the sensor slot that holds
-    the fraction."""
+def sparse_coefficients(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """y ≈ c₀ + x c by the LARS lasso with its penalty chosen by BIC, on standardised
+    columns: c in the units of x's columns (0 for a term left out), shape (k,)."""
+    # imported here: scikit-learn costs ~1 s to import and most diagnoses never get here
+    from sklearn.linear_model import LassoLarsIC
 
-    family: str
-    key: str
-    symbol: str
-    bound: float  # |fraction| admissible
+    spread = x.std(axis=0)
+    fit = LassoLarsIC(criterion="bic").fit((x - x.mean(axis=0)) / spread, y)
+    return np.asarray(fit.coef_) / spread
+
+
+@dataclass(frozen=True)
+class ChannelTerm(Term):
+    """Another measured channel the F_x channel may carry (the coefficient: a fraction)."""
+
     values: Callable[[ClassifiedRun], np.ndarray]
 
 
@@ -93,31 +105,33 @@ CHANNEL_LIBRARY = (
 )
 
 
-def select_channel_terms(runs: Sequence[ClassifiedRun], params: RigParameters
-                         ) -> dict[ChannelTerm, float]:
+def select_channel_terms(runs: Sequence[ClassifiedRun], braking: Sequence[br.Braking],
+                         params: RigParameters) -> dict[ChannelTerm, float]:
     """The channels the F_x channel carries, with their fractions, where the true F_x is
-    known: before braking and off the ground (sparse regression, BIC; kept when they move
-    F_x by more than the consistency floor)."""
+    known: before braking (``braking``: the braking runs prepared) and off the ground (the
+    other ``runs``); sparse regression, BIC; kept when they move F_x by more than the
+    consistency floor."""
     excess, columns = [], []
-    for run in runs:
-        if run.braking:
-            mask, y = free_rolling_excess(br.prepare(run, params), params)
-        else:
-            mask, y = np.ones(len(run), dtype=bool), run.longitudinal_force_n
+    for b in braking:
+        mask, y = free_rolling_excess(b, params)
         excess.append(y[::DECIMATE])
-        x = np.column_stack([t.values(run)[mask] for t in CHANNEL_LIBRARY])
-        columns.append(x[::DECIMATE])
+        columns.append(_channels(b.run, mask))
+    for run in runs:
+        if not run.braking:
+            excess.append(run.longitudinal_force_n[::DECIMATE])
+            columns.append(_channels(run, np.ones(len(run), dtype=bool)))
     y, x = np.concatenate(excess), np.vstack(columns)
     if y.size < 4 * len(CHANNEL_LIBRARY):
         return {}
-    from sklearn.linear_model import LassoLarsIC
-
-    spread = x.std(axis=0)
-    fit = LassoLarsIC(criterion="bic").fit((x - x.mean(axis=0)) / spread, y)
-    fractions = fit.coef_ / spread
+    fractions = sparse_coefficients(x, y)
     return {term: float(c) for term, c, top in zip(CHANNEL_LIBRARY, fractions,
                                                    np.max(np.abs(x), axis=0), strict=True)
             if abs(c) * top > FORCE_FLOOR_N}
+
+
+def _channels(run: ClassifiedRun, mask: np.ndarray) -> np.ndarray:
+    """The library's channels of ``run`` at ``mask``, decimated, shape (m, k)."""
+    return np.column_stack([t.values(run)[mask] for t in CHANNEL_LIBRARY])[::DECIMATE]
 
 
 def channel_candidate(terms: dict[ChannelTerm, float]) -> Candidate:
@@ -125,14 +139,9 @@ def channel_candidate(terms: dict[ChannelTerm, float]) -> Candidate:
     calibration (the brake gain of the torque balance, the friction curve of μ = F_x/F_z,
     the flywheel inertia and drag of its momentum balance: without the drag the fraction
     came out 9 % high)."""
-    chosen = list(terms)
-    return Candidate(DISCOVERED, None, tuple(t.key for t in chosen),
-                     (tuple(terms[t] for t in chosen),),
-                     tuple((-t.bound, t.bound) for t in chosen),
-                     ("brake.gain_n_m_per_pa", "flywheel.inertia_kg_m2", "drag.coeff_n_s2_per_m2",
-                      *FRICTION),
-                     BRAKE_RUNS, (*WHEEL, "flywheel_speed_rad_s"), (),
-                     tuple((t.key.split(".")[1], t.key) for t in chosen))
+    return _term_candidate(terms, ("brake.gain_n_m_per_pa", "flywheel.inertia_kg_m2",
+                                   "drag.coeff_n_s2_per_m2", *FRICTION),
+                           (*WHEEL, "flywheel_speed_rad_s"))
 
 
 SKEW_KEY = "sensors.wheel_speed_delay_s"
@@ -147,13 +156,19 @@ def skew_candidate(lag_s: float) -> Candidate:
 
 
 def discovered_candidate(terms: dict[LibraryTerm, float]) -> Candidate:
-    """The kept terms as a candidate the scoring treats like a catalogue entry."""
+    """The kept brake terms as a candidate, fitted with k_b and the friction curve."""
+    return _term_candidate(terms, ("brake.gain_n_m_per_pa", *FRICTION), WHEEL)
+
+
+def _term_candidate(terms: Mapping[TermT, float], free: tuple[str, ...],
+                    channels: tuple[str, ...]) -> Candidate:
+    """Kept library terms (started at their sparse fit, within ±bound) as a candidate the
+    scoring treats like a catalogue entry, fitted on the braking runs."""
     chosen = list(terms)
     return Candidate(DISCOVERED, None, tuple(t.key for t in chosen),
                      (tuple(terms[t] for t in chosen),),
-                     tuple((-t.bound, t.bound) for t in chosen),
-                     ("brake.gain_n_m_per_pa", *FRICTION), BRAKE_RUNS, WHEEL, (),
-                     tuple((t.key.split(".")[1], t.key) for t in chosen))
+                     tuple((-t.bound, t.bound) for t in chosen), free, BRAKE_RUNS, channels,
+                     (), tuple((t.key.split(".")[1], t.key) for t in chosen))
 
 
 def families(candidate: Candidate) -> str:

@@ -9,7 +9,7 @@ NODES = ("plant", "actuator", "loading_device", "profile", "recorder", "replay")
 
 setup(
     name=PACKAGE,
-    version="0.1.0",
+    version="0.2.0",
     description="Digital twin of an aircraft landing-gear anti-skid test rig",
     license="Apache-2.0",
     python_requires=">=3.10",
@@ -20,6 +20,10 @@ setup(
         (f"share/{PACKAGE}", ["package.xml"]),
         (f"share/{PACKAGE}/config", glob("config/*.yaml")),
         (f"share/{PACKAGE}/launch", glob("launch/*.launch.py")),
+        # a sourced colcon workspace puts this folder on PATH (colcon.pkg hooks); a plain
+        # pip install has the console script in bin/ already, and this folder off PATH
+        (f"share/{PACKAGE}/bin", ["scripts/landing-gear-sim"]),
+        (f"share/{PACKAGE}/hook", ["hooks/cli_path.dsv", "hooks/cli_path.sh"]),
     ],
     install_requires=[
         "numpy>=1.24",

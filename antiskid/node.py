@@ -20,11 +20,10 @@ from landing_gear_sim.ros.nodes.common import (
     GraphNode,
     Handshake,
     announce_ready,
-    declare,
     main_for,
-    rig_and_run,
     step_of,
 )
+from landing_gear_sim.ros.nodes.parameters import declare, rig_and_run
 from msg_tools.contract import TOPIC_CURRENT, TOPIC_FLYWHEEL, TOPIC_WHEEL
 
 from .closed_loop import CONTROLLERS, make_controller, settings_type

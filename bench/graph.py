@@ -36,11 +36,11 @@ def _rig(*args: str, **overrides: float) -> subprocess.CompletedProcess:
                           capture_output=True, text=True, timeout=900)
 
 
-def lockstep_rtf(rate_hz: float, folder: Path) -> float:
+def lockstep_rtf(rate_hz: float, folder: Path, *extra: str) -> float:
     """Real-time factor of one lockstep braking run, as the plant measures it."""
-    done = _rig("--profile", "osc-low", "--rate", str(rate_hz), "--bag",
-                str(folder / f"lockstep_{rate_hz:g}"), **{"rig_test.brake_start_s": 0.3,
-                                                         "rig_test.max_duration_s": LOCKSTEP_SIM_S})
+    bag = folder / f"lockstep_{rate_hz:g}{''.join(extra)}"
+    done = _rig("--profile", "osc-low", "--rate", str(rate_hz), "--bag", str(bag), *extra,
+                **{"rig_test.brake_start_s": 0.3, "rig_test.max_duration_s": LOCKSTEP_SIM_S})
     found = re.search(r"real-time factor ([0-9.]+)", done.stderr)
     if done.returncode != 0 or not found:
         raise RuntimeError(done.stderr[-2000:])
@@ -151,12 +151,16 @@ def main() -> None:
     floor = ping_pong_rate(PING_PONG_S)
     _row("bare rclpy 2-process ping-pong", f"{floor:.0f}/s", "-", None)
     with tempfile.TemporaryDirectory() as folder:
+        rtfs = {}
         for rate in RATES_HZ:
-            rtf = lockstep_rtf(rate, Path(folder))
+            rtf = rtfs[rate] = lockstep_rtf(rate, Path(folder))
             target = TARGET_RTF.get(rate)
             _row(f"lockstep RTF at {rate} Hz exchange", f"{rtf:.2f}",
                  f">= {target:g}" if target else "-", rtf / target if target else None)
             print(f"{'':46s}{rtf * rate:.0f} steps/s = {rtf * rate / floor:.2f} x the ping-pong")
+        bare = lockstep_rtf(1000, Path(folder), "--no-parameter-services")
+        _row("lockstep RTF at 1000 Hz, no parameter services", f"{bare:.2f}", "-", None)
+        print(f"{'':46s}with services / without: {rtfs[1000] / bare:.2f}")
     published, jitter_p99, at_plant = realtime_periods(REALTIME_S)
     _row(f"real time {REALTIME_RATE_HZ} Hz, {REALTIME_S:g} s: periods published",
          f"{100 * published:.2f} %", ">= 99.9 %", published / 0.999)

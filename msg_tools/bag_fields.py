@@ -2,7 +2,8 @@
 
 The contract topics (:mod:`msg_tools.contract`) are used where present. Otherwise a topic
 is found by its tail: ``/brake/pressure`` matches ``/rig2/brake/pressure`` or
-``/brake/pressure`` (one match only), and ``joint_state`` also matches ``joint_states``. A
+``/brake/pressure`` (one match only), and ``joint_states`` also matches ``joint_state``
+(the graph's name for the speeds in 0.1, and other rigs'). A
 column-mapping file may name ``topic`` and ``field`` (``data``, ``fluid_pressure``,
 ``velocity[0]``, ``velocity[wheel]`` — a JointState entry by joint name —, ``position[0]``,
 ``wrench.force.x``). A JointState without velocities gives its positions, which the reader
@@ -19,6 +20,7 @@ from typing import Any
 
 from .contract import (
     ATMOSPHERE_PA,
+    NAMESPACE,
     TOPIC_CURRENT,
     TOPIC_FLYWHEEL,
     TOPIC_PRESSURE,
@@ -112,8 +114,8 @@ def resolve(mapping: dict[str, Channel], topics: Sequence[str], where: str) -> l
 def _find_topic(contract_topic: str, topics: Sequence[str], contract: str, where: str) -> str:
     if contract_topic in topics:
         return contract_topic
-    tail = contract_topic.removeprefix("/rig")
-    tails = {tail, tail + "s"} if tail.endswith("joint_state") else {tail}
+    tail = contract_topic.removeprefix(f"/{NAMESPACE}")
+    tails = {tail, tail.removesuffix("s")} if tail.endswith("joint_states") else {tail}
     found = [t for t in topics if any(t.endswith(x) for x in tails)]
     if len(found) == 1:
         return found[0]

@@ -69,17 +69,20 @@ def contract_messages(run: Run, k: int) -> dict[str, Any]:
 def write_bag(run: Run, path: Path, storage: str = "mcap") -> None:
     """Write ``run`` as a rosbag2 with the contract topics (log time = sample time).
 
-    Written under a hidden name and renamed when complete: an interrupted write leaves
-    no bag (and a hidden ``.name.part`` folder that the next write replaces).
+    Written inside a hidden ``.name.part`` folder and moved out when complete: an
+    interrupted write leaves no bag (and that folder, which the next write replaces).
     """
     path = Path(path)
     if storage not in STORAGE:
         raise RunFormatError(f"unknown bag storage {storage!r}; use mcap or sqlite3")
     if path.exists():
         raise RunFormatError(f"{path}: exists already, not overwriting")
-    partial = path.with_name(f".{path.name}.part")
-    shutil.rmtree(partial, ignore_errors=True)
-    with Writer(partial, version=BAG_VERSION, storage_plugin=STORAGE[storage]) as writer:
+    stage = path.with_name(f".{path.name}.part")
+    shutil.rmtree(stage, ignore_errors=True)
+    # the storage file is named after its folder, and mcap embeds that name: write it in a
+    # folder of the final name, inside the hidden stage
+    with Writer(stage / path.name, version=BAG_VERSION,
+                storage_plugin=STORAGE[storage]) as writer:
         connections = {topic: writer.add_connection(topic, msgtype, typestore=TYPESTORE)
                        for topic, msgtype in TOPIC_TYPES.items()}
         for k in range(len(run)):
@@ -87,16 +90,5 @@ def write_bag(run: Run, path: Path, storage: str = "mcap") -> None:
             for topic, message in contract_messages(run, k).items():
                 data = TYPESTORE.serialize_cdr(message, TOPIC_TYPES[topic])
                 writer.write(connections[topic], log_time, data)
-    _rename_storage_files(partial, path.name)
-    os.replace(partial, path)
-
-
-def _rename_storage_files(folder: Path, name: str) -> None:
-    """Name the storage files after the bag, not after the temporary folder."""
-    meta = folder / "metadata.yaml"
-    text = meta.read_text()
-    for old in sorted(folder.glob(f"{folder.name}*")):
-        new = name + old.name[len(folder.name):]
-        os.replace(old, folder / new)
-        text = text.replace(old.name, new)
-    meta.write_text(text)
+    os.replace(stage / path.name, path)
+    stage.rmdir()

@@ -8,6 +8,12 @@ closed segment. A reader (``rosbags``, ``ros2 bag info/play``, Foxglove
 via the storage files) therefore always sees a valid bag: after ``SIGKILL`` it holds
 everything up to the last closed segment. The open segment lives in a hidden
 ``.open_segment`` folder inside the bag and is never listed.
+
+On :meth:`~SegmentedBagWriter.close` the segments are joined into one file (``join``,
+default), which single-file viewers (Foxglove, PlotJuggler) prefer: the joined file is
+listed in place of the segments in one atomic metadata write, then the segments go, so a
+crash while joining still leaves the segmented bag. Every storage file is written in a
+folder of its own final name, because mcap embeds the name (no temporary names inside).
 """
 
 from __future__ import annotations
@@ -18,12 +24,13 @@ from pathlib import Path
 from typing import Any
 
 import yaml
-from rosbags.rosbag2 import Writer
+from rosbags.rosbag2 import Reader, Writer
 
 from .bag_io import BAG_VERSION, STORAGE, TYPESTORE
 from .errors import RunFormatError
 
 OPEN_SEGMENT = ".open_segment"
+JOINING = ".joining"
 META = "rosbag2_bagfile_information"
 
 
@@ -35,9 +42,11 @@ class SegmentedBagWriter:
         topics: ``{topic: message type}``, e.g.
             ``{"/rig/brake/current_ref": "std_msgs/msg/Float64"}``.
         storage: ``mcap`` or ``sqlite3``.
+        join: on close, join the segments into one storage file.
     """
 
-    def __init__(self, path: Path, topics: dict[str, str], storage: str = "mcap") -> None:
+    def __init__(self, path: Path, topics: dict[str, str], storage: str = "mcap",
+                 join: bool = True) -> None:
         if storage not in STORAGE:
             raise RunFormatError(f"unknown bag storage {storage!r}; use mcap or sqlite3")
         self.path = Path(path)
@@ -46,6 +55,7 @@ class SegmentedBagWriter:
         self.path.mkdir(parents=True)
         self._topics = dict(topics)
         self._storage = storage
+        self._join = join
         self._closed: list[dict[str, Any]] = []
         self._writer: Writer | None = None
         self._connections: dict[str, Any] = {}
@@ -69,16 +79,41 @@ class SegmentedBagWriter:
             self._close_segment()
 
     def close(self) -> None:
-        """Close the open segment; the bag is complete. Safe to call twice."""
+        """Close the open segment and join the segments; the bag is complete. Safe to call
+        twice."""
         if self._writer is not None:
             self._close_segment()
         if not self._closed:
             self._open()  # an empty run still leaves a readable bag
             self._close_segment(keep_empty=True)
+        if self._join and self._closed[0]["relative_file_paths"][0].startswith(
+                f"{self.path.name}_"):  # not joined yet (one segment too: one name always)
+            self._join_segments()
+
+    def _join_segments(self) -> None:
+        work = self.path / JOINING
+        shutil.rmtree(work, ignore_errors=True)
+        segments = [self.path / s["relative_file_paths"][0] for s in self._closed]
+        with Reader(self.path) as reader, Writer(
+                work / self.path.name, version=BAG_VERSION,
+                storage_plugin=STORAGE[self._storage]) as writer:
+            connections = {topic: writer.add_connection(topic, kind, typestore=TYPESTORE)
+                           for topic, kind in self._topics.items()}
+            for connection, log_time_ns, raw in reader.messages():
+                writer.write(connections[connection.topic], log_time_ns, raw)
+        info = yaml.safe_load((writer.path / "metadata.yaml").read_text())[META]
+        name = info["relative_file_paths"][0]
+        os.replace(writer.path / name, self.path / name)
+        os.replace(writer.path / "metadata.yaml", self.path / "metadata.yaml")
+        for segment in segments:
+            segment.unlink()
+        shutil.rmtree(work, ignore_errors=True)
+        self._closed = [info]
 
     def _open(self) -> None:
-        folder = self.path / OPEN_SEGMENT
-        shutil.rmtree(folder, ignore_errors=True)
+        shutil.rmtree(self.path / OPEN_SEGMENT, ignore_errors=True)
+        # named as it will be in the bag (mcap embeds its file name)
+        folder = self.path / OPEN_SEGMENT / f"{self.path.name}_{len(self._closed)}"
         writer = Writer(folder, version=BAG_VERSION, storage_plugin=STORAGE[self._storage])
         writer.open()
         self._connections = {topic: writer.add_connection(topic, kind, typestore=TYPESTORE)
@@ -88,16 +123,14 @@ class SegmentedBagWriter:
     def _close_segment(self, keep_empty: bool = False) -> None:
         writer, self._writer = self._writer, None
         writer.close()  # type: ignore[union-attr]
-        folder = self.path / OPEN_SEGMENT
+        folder = writer.path  # type: ignore[union-attr]
         if self._count or keep_empty:
             info = yaml.safe_load((folder / "metadata.yaml").read_text())[META]
-            source = folder / info["relative_file_paths"][0]
-            name = f"{self.path.name}_{len(self._closed)}{source.suffix}"
-            os.replace(source, self.path / name)
-            info["relative_file_paths"], info["files"][0]["path"] = [name], name
+            name = info["relative_file_paths"][0]
+            os.replace(folder / name, self.path / name)
             self._closed.append(info)
             self._write_metadata()
-        shutil.rmtree(folder, ignore_errors=True)
+        shutil.rmtree(self.path / OPEN_SEGMENT, ignore_errors=True)
 
     def _write_metadata(self) -> None:
         merged = dict(self._closed[0])

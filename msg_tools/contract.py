@@ -34,9 +34,14 @@ CSV_TO_FIELD: dict[str, str] = {
 
 TOPIC_CURRENT = "/rig/brake/current_ref"
 TOPIC_PRESSURE = "/rig/brake/pressure"
-TOPIC_WHEEL = "/rig/wheel/joint_state"
-TOPIC_FLYWHEEL = "/rig/flywheel/joint_state"
+# the speeds were on .../joint_state in 0.1; readers still take bags with those names
+TOPIC_WHEEL = "/rig/wheel/joint_states"
+TOPIC_FLYWHEEL = "/rig/flywheel/joint_states"
 TOPIC_WRENCH = "/rig/load_cell/wrench"
+
+NAMESPACE = "rig"
+"""Namespace of the graph's nodes by default; every topic above is relative to it (a rig
+started in another namespace, ``/rig2``, publishes ``/rig2/brake/pressure``)."""
 
 TOPIC_TYPES: dict[str, str] = {
     TOPIC_CURRENT: "std_msgs/msg/Float64",

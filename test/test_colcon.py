@@ -2,17 +2,22 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
+import re
 import shutil
+import signal
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-PACKAGE_FILES = ("package.xml", "setup.py", "setup.cfg", "README.md", "resource", "config",
-                 "landing_gear_sim", "antiskid", "msg_tools", "launch")
+PACKAGE_FILES = ("package.xml", "setup.py", "setup.cfg", "README.md", "colcon.pkg", "resource",
+                 "config", "hooks", "scripts", "landing_gear_sim", "antiskid", "msg_tools",
+                 "launch")
 COLCON = Path(sys.executable).parent / "colcon"
 
 
@@ -69,6 +74,21 @@ echo "prefix=$prefix"
     assert "friction.theta1" in result.stdout
 
 
+def test_the_command_is_on_path_in_a_sourced_workspace_and_the_nodes_are_not(workspace):
+    script = "source install/setup.bash && command -v landing-gear-sim && landing-gear-sim " \
+             "--version && ! command -v plant"
+    env = {k: v for k, v in os.environ.items() if k != "VIRTUAL_ENV"}
+    env["PATH"] = os.pathsep.join(p for p in env["PATH"].split(os.pathsep)
+                                  if not (Path(p) / "landing-gear-sim").exists())
+    result = subprocess.run(["bash", "-c", script], cwd=workspace, capture_output=True,
+                            text=True, check=False, env=env)
+    assert result.returncode == 0, result.stdout + result.stderr
+    where, version = result.stdout.splitlines()[:2]
+    assert where == str(workspace / "install/landing_gear_sim/share/landing_gear_sim/bin/"
+                                     "landing-gear-sim")
+    assert version.startswith("landing-gear-sim ")
+
+
 def test_an_installed_node_runs_and_refuses_a_bad_parameter(workspace):
     """`ros2 run landing_gear_sim plant` starts rclpy, reads its parameters, says what is wrong."""
     script = """
@@ -86,10 +106,123 @@ install/landing_gear_sim/lib/landing_gear_sim/plant --ros-args -p run.profile:=n
 
 
 REAL_ROS2 = shutil.which("ros2")
+needs_ros2 = pytest.mark.skipif(
+    REAL_ROS2 is None, reason="the real ros2/launch_ros tools are not on PATH (build them "
+    "with ../shared/tools/rosenv-recipe.sh; CI cannot)")
+SHORT = {"rig_test.brake_start_s": 0.3, "rig_test.max_duration_s": 1.5}
+NODES = ("plant", "actuator", "loading_device", "profile", "recorder")
 
 
-@pytest.mark.skipif(REAL_ROS2 is None, reason="the real ros2/launch_ros tools are not on PATH "
-                    "(build them with ../shared/tools/rosenv-recipe.sh; CI cannot)")
+def _sourced(workspace: Path, command: str, **popen: Any) -> subprocess.Popen:
+    """``command`` in bash with the workspace sourced (the user's domain: the test's)."""
+    return subprocess.Popen(["bash", "-c", f"source install/setup.bash && {command}"],
+                            cwd=workspace, text=True, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, **popen)
+
+
+def _ros(workspace: Path, command: str, timeout: float = 120) -> tuple[int, str]:
+    process = _sourced(workspace, command)
+    output, _ = process.communicate(timeout=timeout)
+    return process.returncode, output
+
+
+def _param(verb: str, arguments: str) -> str:
+    # a discovery of its own: a daemon started moments ago does not know every node yet
+    return f"ros2 param {verb} --no-daemon --spin-time 3 {arguments}"
+
+
+@pytest.fixture
+def short_params(tmp_path) -> Path:
+    from landing_gear_sim.model.parameters import load_parameters
+
+    path = tmp_path / "short.yaml"
+    load_parameters(overrides=SHORT).to_yaml(path)
+    return path
+
+
+@needs_ros2
+@pytest.mark.parametrize("arguments", [
+    "profile:=constant pressure_bar:=20 storage:=sqlite3 namespace:=rig2 bag:={bag}",
+    "controller:=slip clock:=realtime bag:={bag}",
+    "profile:=file file:={csv}",
+], ids=["constant-sqlite3-namespace", "controller-realtime", "file"])
+def test_ros2_launch_takes_every_argument(workspace, tmp_path, short_params, arguments):
+    from landing_gear_sim.model.integrate import simulate
+    from landing_gear_sim.model.parameters import load_parameters
+    from landing_gear_sim.model.runspec import RunSpec, build_scenario
+    from msg_tools.bag_read import read_bag
+    from msg_tools.csv_io import write_csv
+
+    params = load_parameters(overrides=SHORT)
+    csv = tmp_path / "run.csv"
+    write_csv(simulate(params, build_scenario(RunSpec(profile="steps"), params)).to_run(), csv)
+    bag = tmp_path / "bag"
+    line = arguments.format(bag=bag, csv=csv)
+    code, output = _ros(workspace, f"ros2 launch landing_gear_sim rig.launch.py {line} "
+                                   f"params_file:={short_params}", timeout=300)
+    assert code == 0, output[-3000:]
+    assert "Traceback" not in output and "process has died" not in output, output[-3000:]
+    if "bag:=" in arguments:
+        assert len(read_bag(bag)) == 1500, output[-3000:]
+
+
+@needs_ros2
+def test_ros2_tools_on_a_running_rig_a_second_rig_beside_it_and_ctrl_c(workspace, tmp_path,
+                                                                        short_params):
+    """`ros2 topic hz/echo`, `ros2 param list/get/set` on each node, a second rig in its own
+    namespace on the same domain, then a terminal's Ctrl-C on the first `ros2 launch`."""
+    bag = tmp_path / "bag"
+    # a light constant pressure: a stop of a minute, still running when the tools are done
+    launch = _sourced(workspace, "exec ros2 launch landing_gear_sim rig.launch.py "
+                      f"profile:=constant pressure_bar:=3 bag:={bag}", start_new_session=True)
+    try:
+        next(line for line in iter(launch.stdout.readline, "") if "run starts" in line)
+        code, hz = _ros(workspace, "timeout -s INT 12 ros2 topic hz /rig/wheel/joint_states")
+        rates = [float(x) for x in re.findall(r"average rate: ([0-9.]+)", hz)]
+        assert rates and rates[-1] > 100, hz  # the average over the last window
+        code, echo = _ros(workspace, "ros2 topic echo --once /rig/brake/pressure "
+                                       "sensor_msgs/msg/FluidPressure")
+        assert code == 0 and "fluid_pressure:" in echo, echo
+        for node in NODES:
+            code, names = _ros(workspace, _param("list", f"/rig/{node}"))
+            assert code == 0 and "clock" in names.split(), (node, names)
+        code, value = _ros(workspace, _param("get", "/rig/plant friction.theta1"))
+        assert code == 0 and "Double value is:" in value, value
+        code, refused = _ros(workspace, _param("set", "/rig/plant friction.theta1 -1.0"))
+        assert "friction.theta1 must not be negative" in refused, refused
+        code, second = _ros(workspace, "ros2 launch landing_gear_sim rig.launch.py "
+                                       f"namespace:=rig2 params_file:={short_params} "
+                                       f"bag:={tmp_path / 'second'}", timeout=300)
+        assert code == 0 and "bag closed" in second, second[-3000:]
+        os.killpg(launch.pid, signal.SIGINT)
+        output, _ = launch.communicate(timeout=60)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(launch.pid, signal.SIGKILL)
+    assert launch.returncode in (0, 130), output[-3000:]
+    assert "Traceback" not in output and "process has died" not in output, output[-3000:]
+    assert subprocess.run(["pgrep", "-s", str(launch.pid)]).returncode == 1  # no orphan
+    assert "bag closed" in output and sorted(p.name for p in bag.iterdir()) == [
+        "bag.mcap", "metadata.yaml"]
+
+
+@needs_ros2
+@pytest.mark.parametrize("node", [*NODES, "antiskid_controller"])
+def test_ros2_run_of_each_node_starts_and_stops_on_ctrl_c(workspace, tmp_path, node):
+    extra = f"-p bag:={tmp_path / 'bag'}" if node == "recorder" else ""
+    process = _sourced(workspace, f"exec ros2 run landing_gear_sim {node} --ros-args {extra}",
+                       start_new_session=True)
+    try:
+        next(line for line in iter(process.stdout.readline, "") if "running" in line)
+        os.killpg(process.pid, signal.SIGINT)
+        output, _ = process.communicate(timeout=60)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(process.pid, signal.SIGKILL)
+    assert process.returncode == 0 and "Traceback" not in output, output[-3000:]
+
+
+@needs_ros2
 def test_the_readme_launch_command_runs_in_real_launch_ros(workspace, tmp_path):
     """`ros2 launch landing_gear_sim rig.launch.py profile:=osc-low bag:=...` once failed in
     real launch_ros (an empty list parameter); stand-in launch modules had hidden it."""

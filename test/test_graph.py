@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import runpy
 import sys
 import types
@@ -73,7 +74,7 @@ def test_the_plant_waits_for_every_peer_and_each_node_for_its_readers(tmp_path):
                                                   "recorder"]
     expected = dict(item.split("=") for item in nodes["plant"].parameters["expected_subscribers"])
     # wheel: profile + recorder; flywheel: loading device + recorder; latched/clock not awaited
-    assert expected == {"/rig/wheel/joint_state": "2", "/rig/flywheel/joint_state": "2",
+    assert expected == {"/rig/wheel/joint_states": "2", "/rig/flywheel/joint_states": "2",
                         "/rig/brake/pressure": "1", "/rig/load_cell/wrench": "1"}
     assert TOPIC_CLOCK not in expected and TOPIC_RUN_END not in expected
     assert nodes["profile"].parameters["expected_subscribers"] == ["/rig/brake/current_ref=2"]
@@ -114,8 +115,17 @@ def test_node_command_runs_the_module_with_the_params_file(tmp_path):
     plant = describe(GraphOptions())[0]
     command = node_command(plant, tmp_path / "p.yaml", "python")
     assert command[:4] == ["python", "-m", "landing_gear_sim.ros.nodes.plant", "--ros-args"]
-    assert command[4:6] == ["--params-file", str(tmp_path / "p.yaml")]
+    assert command[4:8] == ["-r", "__ns:=/rig", "--params-file", str(tmp_path / "p.yaml")]
     assert "clock:='lockstep'" in command
+
+
+def test_a_second_rig_moves_every_node_and_topic_into_its_namespace():
+    nodes = describe(GraphOptions(namespace="lab/rig2"))
+    assert {node.namespace for node in nodes} == {"lab/rig2"}
+    assert "__ns:=/lab/rig2" in node_command(nodes[0], Path("p.yaml"))
+    for bad in ("2rig", "rig-2", "/rig", "rig//2", ""):
+        with pytest.raises(LandingGearSimError, match="namespace"):
+            GraphOptions(namespace=bad)
 
 
 def test_the_launcher_leaves_the_users_dds_settings_alone():
@@ -195,14 +205,32 @@ def _values(path: Path) -> list[float]:
                 for c, _, raw in reader.messages()]
 
 
-@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
-def test_a_segmented_bag_reads_as_one_bag(tmp_path, storage):
-    writer = SegmentedBagWriter(tmp_path / "bag", {"/x": "std_msgs/msg/Float64"}, storage)
+def _segmented(path: Path, storage: str = "mcap", join: bool = True) -> SegmentedBagWriter:
+    writer = SegmentedBagWriter(path, {"/x": "std_msgs/msg/Float64"}, storage, join)
     for k in range(30):
         writer.write("/x", k * 1_000_000, _float64(k))
         if k % 10 == 9:
             writer.roll()
-    writer.close()
+    return writer
+
+
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_a_segmented_bag_closes_as_one_file_named_after_the_bag(tmp_path, storage):
+    """Single-file viewers (Foxglove, PlotJuggler) open one file; mcap embeds its name."""
+    _segmented(tmp_path / "bag", storage).close()
+    assert _values(tmp_path / "bag") == list(range(30))
+    files = sorted(p.name for p in (tmp_path / "bag").iterdir())
+    assert files == [f"bag.{'db3' if storage == 'sqlite3' else 'mcap'}", "metadata.yaml"]
+    meta = yaml.safe_load((tmp_path / "bag" / "metadata.yaml").read_text())
+    assert meta["rosbag2_bagfile_information"]["relative_file_paths"] == [files[0]]
+    assert meta["rosbag2_bagfile_information"]["message_count"] == 30
+    if storage == "mcap":  # the metadata inside the file names the file, not a stage
+        data = (tmp_path / "bag" / files[0]).read_bytes()
+        assert b"bag.mcap" in data and b".open_segment" not in data and b".joining" not in data
+
+
+def test_segments_are_kept_when_asked(tmp_path):
+    _segmented(tmp_path / "bag", join=False).close()
     assert _values(tmp_path / "bag") == list(range(30))
     assert len(list((tmp_path / "bag").glob("bag_*"))) == 3
     assert not (tmp_path / "bag" / OPEN_SEGMENT).exists()
@@ -216,6 +244,25 @@ def test_a_crashed_writer_leaves_a_bag_with_every_closed_segment(tmp_path):
             writer.roll()
     # no close(): as after SIGKILL, samples 20-24 are in the open segment only
     assert _values(tmp_path / "bag") == list(range(20))
+    segment = next((tmp_path / "bag").glob("bag_0.*")).read_bytes()
+    assert b"bag_0.mcap" in segment and b".open_segment" not in segment
+
+
+def test_a_crash_while_joining_leaves_the_segmented_bag(tmp_path, monkeypatch):
+    writer = _segmented(tmp_path / "bag")
+    monkeypatch.setattr("msg_tools.bag_segments.os.replace", _fail_on_the_joined_file)
+    with pytest.raises(OSError):
+        writer.close()
+    assert _values(tmp_path / "bag") == list(range(30))
+
+
+_REPLACE = os.replace
+
+
+def _fail_on_the_joined_file(source, target):
+    if Path(source).parent.parent.name == ".joining":
+        raise OSError("disk full")
+    _REPLACE(source, target)
 
 
 def test_an_empty_recording_is_still_a_readable_bag(tmp_path):

@@ -6,10 +6,11 @@ import dataclasses
 
 import numpy as np
 import pytest
+from rosbags.rosbag2 import Reader, Writer
 
 from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
-from msg_tools.bag_io import write_bag
+from msg_tools.bag_io import BAG_VERSION, TYPESTORE, write_bag
 from msg_tools.bag_read import read_bag
 from msg_tools.contract import CSV_COLUMNS
 from msg_tools.csv_io import read_csv, write_csv
@@ -94,3 +95,32 @@ def test_wall_clock_time_keeps_microseconds_through_bag_and_csv(tmp_path, run):
     assert np.max(np.abs(back.time_s - stamped.time_s)) < 1e-6
     write_bag(back, tmp_path / "again")
     assert np.max(np.abs(read_bag(tmp_path / "again").time_s - stamped.time_s)) < 1e-6
+
+
+def _renamed(source, target, prefix: str = "", legacy: bool = False) -> None:
+    """Copy a bag with its topics as an older graph (``joint_state``) or another rig
+    (``/rig2/...``) named them."""
+    def name(topic: str) -> str:
+        topic = topic.removesuffix("s") if legacy and topic.endswith("joint_states") else topic
+        return prefix + topic.removeprefix("/rig") if prefix else topic
+
+    with Reader(source) as reader, Writer(target, version=BAG_VERSION) as writer:
+        out = {c.topic: writer.add_connection(name(c.topic), c.msgtype, typestore=TYPESTORE)
+               for c in reader.connections}
+        for connection, log_time, raw in reader.messages():
+            writer.write(out[connection.topic], log_time, raw)
+
+
+@pytest.mark.parametrize(("prefix", "legacy"), [("", True), ("/lab/rig2", False)],
+                         ids=["joint_state of 0.1", "second rig"])
+def test_bags_with_other_names_for_the_contract_topics_read_the_same(tmp_path, run, prefix,
+                                                                      legacy):
+    write_bag(run, tmp_path / "bag")
+    _renamed(tmp_path / "bag", tmp_path / "other", prefix, legacy)
+    with Reader(tmp_path / "other") as reader:
+        topics = {c.topic for c in reader.connections}
+    assert ("/rig/wheel/joint_state" in topics) == legacy
+    assert (f"{prefix}/brake/pressure" in topics) == bool(prefix)
+    back, again = read_bag(tmp_path / "bag"), read_bag(tmp_path / "other")
+    for name in ("time_s", *SIGNALS):
+        assert np.array_equal(getattr(back, name), getattr(again, name)), name

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import signal
@@ -12,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from rosbags.rosbag2 import Reader
 
 from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import load_parameters
@@ -107,11 +109,50 @@ def test_sigint_to_the_graph_leaves_a_bag_with_the_run_up_to_the_stop(tmp_path, 
     launcher.send_signal(signal.SIGINT)
     _, stderr = launcher.communicate(timeout=60)
     assert launcher.returncode == 130, stderr[-2000:]
+    _assert_complete(bag, stderr, _offline(long_run))
+
+
+def _assert_complete(bag: Path, stderr: str, offline) -> None:
+    """The bag is one closed file holding every sample the recorder got, from the first,
+    equal to the offline run; no stage or open segment left behind."""
+    assert "Traceback" not in stderr and "died" not in stderr, stderr[-3000:]
+    closed = re.search(r"bag closed: .* \((\d+) samples", stderr)
+    assert closed, stderr[-3000:]
+    assert sorted(p.name for p in bag.iterdir()) == ["bag.mcap", "metadata.yaml"]
     stopped = read_bag(bag)
-    offline = _offline(long_run)
-    assert 100 < len(stopped) < len(offline)
+    assert 0 < len(stopped) == int(closed.group(1)) < len(offline)
     np.testing.assert_allclose(stopped.wheel_speed_rad_s,
                                offline.wheel_speed_rad_s[:len(stopped)], rtol=1e-9, atol=1e-6)
+
+
+@pytest.mark.parametrize("moment", ["starting", "running"])
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_a_signal_to_the_whole_process_group_stops_everything_cleanly(tmp_path, sig, moment):
+    """A terminal's Ctrl-C reaches the launcher and every node at once: the recorder once
+    crashed while closing and kept ~1 s of a 7 s run."""
+    bag = tmp_path / "bag"
+    long_run = {**SHORT, "rig_test.max_duration_s": 30.0}
+    launcher = subprocess.Popen(_rig("--profile", "osc-low", "--bag", str(bag),
+                                     overrides=long_run),
+                                env=ros_environment(), start_new_session=True, text=True,
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        lines = iter(launcher.stderr.readline, "")
+        cue = "starting" if moment == "starting" else "run starts"
+        seen = next(line for line in lines if cue in line)
+        if moment == "running":  # the first segment is closed: hundreds of samples
+            _wait_for(lambda: (bag / "metadata.yaml").exists())
+        os.killpg(launcher.pid, sig)
+        _, rest = launcher.communicate(timeout=60)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(launcher.pid, signal.SIGKILL)
+    assert launcher.returncode == 130, (seen + rest)[-3000:]
+    assert subprocess.run(["pgrep", "-s", str(launcher.pid)]).returncode == 1  # no orphan
+    if moment == "running":
+        _assert_complete(bag, rest, _offline(long_run))
+    else:
+        assert "Traceback" not in rest and not bag.exists(), rest[-3000:]
 
 
 def test_a_killed_recorder_leaves_a_readable_bag_and_the_run_goes_on(tmp_path, start):
@@ -266,3 +307,87 @@ def test_a_signal_to_a_lone_node_ends_it_cleanly(tmp_path, start, node, sig):
     _, errors = process.communicate(timeout=30)
     assert process.returncode == 0, errors[-2000:]
     assert "Traceback" not in errors
+
+
+def _wait_until_running(process: subprocess.Popen) -> None:
+    deadline = time.monotonic() + 60
+    while "running" not in (line := process.stderr.readline()) and time.monotonic() < deadline:
+        assert process.poll() is None, line
+
+
+def test_a_running_node_answers_ros2_param_and_refuses_changes_with_the_reason(start):
+    """`ros2 param list/get/set` on a node of the graph (it once served no services)."""
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+    from rclpy.parameter_client import AsyncParameterClient
+
+    plant = start([sys.executable, "-m", "landing_gear_sim.ros.nodes.plant", "--ros-args",
+                   "-p", "friction.theta1:=1.1"])
+    _wait_until_running(plant)
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    try:
+        node = rclpy.create_node("param_probe", context=context)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(node)
+        client = AsyncParameterClient(node, "/rig/plant")
+        assert client.wait_for_services(timeout_sec=30)
+
+        def call(future):
+            executor.spin_until_future_complete(future, timeout_sec=30)
+            assert future.done()
+            return future.result()
+
+        names = call(client.list_parameters()).result.names
+        assert {"friction.theta1", "run.profile", "clock", "timeout_s"} <= set(names)
+        assert call(client.get_parameters(["friction.theta1"])).values[0].double_value == 1.1
+        bad, valid = (call(client.set_parameters([Parameter("friction.theta1", value=v)]))
+                      .results[0] for v in (-1.0, 1.2))
+        assert not bad.successful and "friction.theta1 must not be negative" in bad.reason
+        assert not valid.successful and "read when the run starts" in valid.reason
+        assert call(client.get_parameters(["friction.theta1"])).values[0].double_value == 1.1
+        node.destroy_node()
+    finally:
+        rclpy.shutdown(context=context)
+    plant.send_signal(signal.SIGINT)
+    assert plant.wait(timeout=30) == 0
+
+
+def test_a_misspelt_parameter_stops_the_node_with_the_closest_name(tmp_path):
+    plant = _run([sys.executable, "-m", "landing_gear_sim.ros.nodes.plant", "--ros-args",
+                  "-p", "run.profil:=steps"])
+    assert plant.returncode == 2
+    assert plant.stderr.strip().splitlines()[-1] == (
+        "plant: error: unknown parameter 'run.profil' (did you mean 'run.profile'?)")
+    params = tmp_path / "params.yaml"  # the rig's keys for every node are no typo
+    params.write_text("/**:\n  ros__parameters:\n    friction.theta1: 1.0\n"
+                      "    run.profile: steps\n    segmentt_s: 1.0\n")
+    recorder = _run([sys.executable, "-m", "landing_gear_sim.ros.nodes.recorder", "--ros-args",
+                     "--params-file", str(params), "-p", f"bag:={tmp_path / 'bag'}"])
+    assert recorder.returncode == 2
+    assert recorder.stderr.strip().splitlines()[-1] == (
+        "recorder: error: unknown parameter 'segmentt_s' (did you mean 'segment_s'?)")
+    assert not (tmp_path / "bag").exists()  # refused before the bag folder is made
+
+
+def test_two_rigs_share_a_domain_each_in_its_namespace(tmp_path, start):
+    """`--namespace` moves every node and topic (start/stop handshake included): two rigs
+    on one domain run the same profile at once and each records exactly its own run."""
+    rigs = {name: start(_rig("--profile", "osc-low", "--namespace", name, "--bag",
+                             str(tmp_path / name))) for name in ("rig_a", "lab/rig_b")}
+    for process in rigs.values():
+        _, errors = process.communicate(timeout=180)
+        assert process.returncode == 0, errors[-3000:]
+    offline = _offline(SHORT)
+    for name in rigs:
+        bag = tmp_path / name
+        with Reader(bag) as reader:
+            assert {c.topic for c in reader.connections} == {
+                f"/{name}/{topic}" for topic in ("brake/current_ref", "brake/pressure",
+                                                 "wheel/joint_states", "flywheel/joint_states",
+                                                 "load_cell/wrench")}
+        graph = read_bag(bag)
+        assert len(graph) == len(offline) == 1500  # one run each: no sample of the other
+        np.testing.assert_allclose(graph.wheel_speed_rad_s, offline.wheel_speed_rad_s,
+                                   rtol=1e-9, atol=1e-6)

@@ -56,7 +56,8 @@ def _terminate(signum: int, frame: object) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the CLI; returns the exit code (130 after Ctrl-C, 143 after SIGTERM)."""
+    """Run the CLI; returns the exit code (130 after Ctrl-C, 143 after SIGTERM; 130 for
+    both from the graph launcher ``rig``, as ``ros2 launch``)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     _check(args, parser)
@@ -80,7 +81,7 @@ def _run(args: argparse.Namespace) -> int:
         return 2
     except Terminated:
         print(f"{PROG}: terminated", file=sys.stderr)
-        return 143
+        return 130 if getattr(args, "launcher", False) else 143  # a launcher says 130
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return 130

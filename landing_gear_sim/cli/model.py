@@ -59,7 +59,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                      help="lockstep: seconds to wait for a silent node before holding its input")
     rig.add_argument("--safe-pressure-bar", type=float, default=0.0,
                      help="brake pressure applied once the actuator is lost (default 0)")
-    rig.set_defaults(func=cmd_rig)
+    rig.add_argument("--namespace", default="rig",
+                     help="namespace of the nodes and topics (default rig; a second rig: rig2)")
+    rig.add_argument("--no-parameter-services", dest="parameter_services",
+                     action="store_false", help="nodes answer no ros2 param (a little faster)")
+    rig.set_defaults(func=cmd_rig, launcher=True)
 
     bode = sub.add_parser("bode", help="frequency responses G_lambda, G_eta (paper Fig. 7)")
     add_params_arguments(bode)
@@ -157,7 +161,9 @@ def cmd_rig(args: argparse.Namespace) -> int:
     options = GraphOptions(run=spec, clock=args.clock, bag=bag, storage=args.storage,
                            sensor_noise=args.noise, timeout_s=args.timeout,
                            safe_pressure_pa=args.safe_pressure_bar * PA_PER_BAR,
-                           replay=args.replay is not None, controller=args.controller)
+                           replay=args.replay is not None, controller=args.controller,
+                           parameter_services=args.parameter_services,
+                           namespace=args.namespace.strip("/"))
     progress(f"{scenario.name}: {args.clock} graph, up to {scenario.duration_s:.1f} s at "
               f"{scenario.rate_hz:g} Hz")
     started = time.perf_counter()
@@ -165,10 +171,13 @@ def cmd_rig(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - started
     print(f"graph run: {wall:.1f} s wall; node exit codes: "
           + ", ".join(f"{name} {code}" for name, code in outcome.exit_codes.items()))
-    if bag is not None:
+    recorded = bag is not None and bag.exists()
+    if bag is not None and recorded:
         print(_bag_summary(bag))
     if outcome.interrupted:
-        print(f"{PROG}: interrupted; the bag holds the run up to the stop", file=sys.stderr)
+        held = ("the bag holds the run up to the stop" if recorded
+                else "stopped before anything was recorded")
+        print(f"{PROG}: interrupted; {held}", file=sys.stderr)
         return 130
     return 0 if outcome.ok else 1
 

@@ -8,8 +8,9 @@ Both ways of bringing the graph up read this description: the ROS launch file
 from __future__ import annotations
 
 import math
+import re
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from landing_gear_sim.errors import GraphError
@@ -17,6 +18,7 @@ from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.runspec import RunSpec, build_scenario
 from landing_gear_sim.model.scenario import Scenario
 from msg_tools.contract import (
+    NAMESPACE,
     TOPIC_CURRENT,
     TOPIC_FLYWHEEL,
     TOPIC_PRESSURE,
@@ -42,6 +44,8 @@ SENSOR_TOPICS = (TOPIC_WHEEL, TOPIC_FLYWHEEL, TOPIC_PRESSURE, TOPIC_WRENCH)
 RECORDED_TOPICS = (TOPIC_CURRENT, *SENSOR_TOPICS)
 
 CONTROLLER_NODE = "antiskid_controller"
+NAMESPACE_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*")
+"""A ROS namespace without its leading '/' (what ``-r __ns:=/...`` and launch accept)."""
 CLOCKS = ("lockstep", "realtime")
 STORAGES = ("mcap", "sqlite3")
 
@@ -56,6 +60,8 @@ class NodeSpec:
     parameters: dict[str, ParamValue]
     publishes: tuple[str, ...]
     subscribes: tuple[str, ...]
+    namespace: str = NAMESPACE
+    """Where the node and its (relative) topics live: ``rig`` → ``/rig/brake/pressure``."""
 
     @property
     def module(self) -> str:
@@ -80,6 +86,9 @@ class GraphOptions:
         controller: anti-skid controller node to run instead of the profile node.
         replay: the run's current comes from the ``replay`` node (``run.file``), not
             the profile node.
+        parameter_services: the nodes answer ``ros2 param`` (off: the bench's comparison).
+        namespace: the rig's namespace (``rig``); a second rig on the same domain takes
+            another (``rig2``) and keeps to its own topics.
     """
     # a controller graph is a rig test braking from rig_test.brake_start_s: run.profile
     # is "external" (see controlled_run)
@@ -93,8 +102,13 @@ class GraphOptions:
     safe_pressure_pa: float = 0.0
     controller: str | None = None
     replay: bool = False
+    parameter_services: bool = True
+    namespace: str = NAMESPACE
 
     def __post_init__(self) -> None:
+        if not NAMESPACE_PATTERN.fullmatch(self.namespace):
+            raise GraphError(f"namespace {self.namespace!r}: use letters, digits and '_' in "
+                             "'/'-separated parts, none starting with a digit (rig, lab/rig2)")
         if self.clock not in CLOCKS:
             raise GraphError(f"clock must be one of {', '.join(CLOCKS)}")
         if self.storage not in STORAGES:
@@ -114,6 +128,7 @@ LAUNCH_ARGUMENTS: dict[str, tuple[str, str]] = {
     "bag": ("", "rosbag2 folder to record into (empty: no recorder)"),
     "storage": ("mcap", "mcap | sqlite3"),
     "controller": ("", "anti-skid controller type instead of the profile (threshold | slip)"),
+    "namespace": (NAMESPACE, "namespace of the rig's nodes and topics (a second rig: rig2)"),
 }
 """Launch-file arguments: name -> (default, description)."""
 
@@ -152,7 +167,7 @@ def options_from_arguments(values: dict[str, str]) -> tuple[GraphOptions, Path]:
                                  pressure_pa=pressure_pa), controller)
     options = GraphOptions(run=run, clock=value("clock"), storage=value("storage"),
                            bag=Path(value("bag")) if value("bag") else None,
-                           controller=controller)
+                           controller=controller, namespace=value("namespace").strip("/"))
     return options, Path(value("params_file") or default_config_files()[0])
 
 
@@ -167,7 +182,9 @@ def run_parameters(run: RunSpec) -> dict[str, ParamValue]:
 def describe(options: GraphOptions) -> list[NodeSpec]:
     """The nodes of the graph for ``options``, plant first, with their expected links."""
     run = run_parameters(options.run)
-    clock = {"clock": options.clock}
+    clock: dict[str, ParamValue] = {"clock": options.clock}
+    if not options.parameter_services:
+        clock["parameter_services"] = False
     nodes = [
         NodeSpec("plant", {**run, **clock, "sensor_noise": options.sensor_noise,
                            "timeout_s": options.timeout_s,
@@ -189,7 +206,7 @@ def describe(options: GraphOptions) -> list[NodeSpec]:
         nodes.append(NodeSpec("recorder", {**clock, "bag": str(options.bag),
                                            "storage": options.storage},
                               (), RECORDED_TOPICS))
-    return _with_links(nodes)
+    return [replace(node, namespace=options.namespace) for node in _with_links(nodes)]
 
 
 def _with_links(nodes: list[NodeSpec]) -> list[NodeSpec]:

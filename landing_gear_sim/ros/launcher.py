@@ -23,6 +23,7 @@ from landing_gear_sim.ros.graph import GraphOptions, NodeSpec, ParamValue, descr
 
 LINGER_S = 10.0  # after the plant ends, how long the others may take to finish on their own
 STOP_S = 5.0  # after SIGINT, how long before SIGKILL
+RESEND_S = 0.5  # SIGINT repeated this often while a node still runs
 
 
 def ros_environment(environ: dict[str, str] | None = None) -> dict[str, str]:
@@ -51,8 +52,8 @@ def node_command(node: NodeSpec, params_file: Path, python: str = sys.executable
     """The command line that runs ``node`` with the graph's params file."""
     overrides = [arg for name, value in node.parameters.items()
                  for arg in ("-p", f"{name}:={format_value(value)}")]
-    return [python, "-m", node.module, "--ros-args", "--params-file", str(params_file),
-            *overrides]
+    return [python, "-m", node.module, "--ros-args", "-r", f"__ns:=/{node.namespace}",
+            "--params-file", str(params_file), *overrides]
 
 
 @dataclass
@@ -84,19 +85,34 @@ def _run_processes(options: GraphOptions, params_file: Path,
     discovery = env.get("ROS_AUTOMATIC_DISCOVERY_RANGE", "unset: SUBNET")
     say(f"starting {', '.join(n.name for n in nodes)} (ROS_DOMAIN_ID {domain}, discovery "
         f"{discovery})")
-    processes = {n.name: subprocess.Popen(node_command(n, params_file), env=env,
-                                          preexec_fn=die_with_parent) for n in nodes}
+    processes: dict[str, subprocess.Popen] = {}
     interrupted = False
-    previous = signal.signal(signal.SIGTERM, _interrupt)
+    # SIGINT too: a shell starts a background job with SIGINT ignored, and the nodes would
+    # stop on the terminal's Ctrl-C while the launcher reported a complete run
+    previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
+        for node in nodes:
+            processes[node.name] = subprocess.Popen(node_command(node, params_file), env=env,
+                                                    preexec_fn=_node_process)
         _wait_for_plant(processes, say)
         _wait_all(processes, LINGER_S)
     except KeyboardInterrupt:
         interrupted = True
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
         _stop(processes)
     return Outcome(_codes(processes), interrupted)
+
+
+def _node_process() -> None:
+    """How a node process starts: it dies with the launcher, and with SIGINT and SIGTERM
+    ignored until its package takes them (``ros/nodes/__init__``). Python's own SIGINT
+    handler made a terminal's Ctrl-C in a node's first milliseconds a KeyboardInterrupt
+    traceback; a signal ignored there is not lost, since :func:`_stop` repeats it."""
+    die_with_parent()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
 
 
 def _interrupt(signum: int, frame: object) -> None:
@@ -125,11 +141,15 @@ def _wait_all(processes: dict[str, subprocess.Popen], timeout_s: float) -> None:
 
 
 def _stop(processes: dict[str, subprocess.Popen]) -> None:
-    """SIGINT whatever still runs (the recorder closes its bag), SIGKILL what hangs."""
-    for process in processes.values():
-        if process.poll() is None:
-            process.send_signal(signal.SIGINT)
-    _wait_all(processes, STOP_S)
+    """SIGINT whatever still runs (the recorder closes its bag), again every
+    :data:`RESEND_S` (a node still starting may not have taken the first), SIGKILL what
+    hangs after :data:`STOP_S`."""
+    deadline = time.monotonic() + STOP_S
+    while time.monotonic() < deadline and any(p.poll() is None for p in processes.values()):
+        for process in processes.values():
+            if process.poll() is None:
+                process.send_signal(signal.SIGINT)
+        _wait_all(processes, min(RESEND_S, deadline - time.monotonic()))
     for process in processes.values():
         if process.poll() is None:
             process.kill()

@@ -16,9 +16,9 @@ from landing_gear_sim.ros.nodes.common import (
     Handshake,
     announce_ready,
     main_for,
-    rig_and_run,
     to_stamp,
 )
+from landing_gear_sim.ros.nodes.parameters import rig_and_run
 from msg_tools.contract import ATMOSPHERE_PA, TOPIC_CURRENT
 
 

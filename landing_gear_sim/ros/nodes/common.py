@@ -6,7 +6,6 @@ and call the blocks of :mod:`landing_gear_sim.model.blocks` once per message.
 
 from __future__ import annotations
 
-import math
 import signal
 import sys
 import time
@@ -16,7 +15,6 @@ from typing import Any
 import rclpy
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import WrenchStamped
-from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
@@ -29,12 +27,11 @@ from sensor_msgs.msg import FluidPressure, JointState
 from std_msgs.msg import Float64, String, UInt64
 
 from landing_gear_sim.errors import GraphError, LandingGearSimError
-from landing_gear_sim.model.parameters import SPECS, RigParameters, load_parameters
-from landing_gear_sim.model.runspec import RunSpec
-from landing_gear_sim.model.scenario import Scenario
-from landing_gear_sim.ros.graph import TOPIC_READY, TOPIC_RUN_END, load_scenario
+from landing_gear_sim.ros.graph import TOPIC_READY, TOPIC_RUN_END
 from landing_gear_sim.ros.nodes import stop_requested
+from landing_gear_sim.ros.nodes.parameters import check_overrides, declare, refuse_changes
 from msg_tools.contract import (
+    NAMESPACE,
     TOPIC_CURRENT,
     TOPIC_FLYWHEEL,
     TOPIC_PRESSURE,
@@ -57,57 +54,6 @@ HANDSHAKE_PERIOD_S = 0.02
 CONTRACT_KINDS = {TOPIC_CURRENT: Float64, TOPIC_PRESSURE: FluidPressure, TOPIC_WHEEL: JointState,
                   TOPIC_FLYWHEEL: JointState, TOPIC_WRENCH: WrenchStamped}
 """rclpy message class of each contract topic (msg_tools.contract.TOPIC_TYPES)."""
-
-
-def declare(node: Node, name: str, default: Any, description: str) -> Any:
-    """Declare one parameter (any type a params file gives it) and return its value."""
-    descriptor = ParameterDescriptor(description=description, dynamic_typing=True)
-    return node.declare_parameter(name, default, descriptor).value
-
-
-def rig_parameters(node: Node) -> RigParameters:
-    """Declare every model parameter (bundled reference rig as default) and validate the set.
-
-    The params file of the graph (``--params-file config/reference_rig.yaml``, or the
-    calibrated one) overrides the defaults; so does ``-p key:=value``.
-    """
-    defaults = load_parameters()
-    values = {spec.key: declare(node, spec.key, defaults[spec.key],
-                                f"{spec.description} [{spec.unit}]") for spec in SPECS}
-    return RigParameters(values, ("node parameters",))
-
-
-def run_spec(node: Node) -> RunSpec:
-    """Declare the ``run.*`` parameters (see graph.run_parameters) and build the RunSpec."""
-    current = float(declare(node, "run.current_a", -1.0, "constant profile current [A]; <0: "
-                            "from run.pressure_pa"))
-    return RunSpec(
-        profile=str(declare(node, "run.profile", "constant", "current profile")),
-        pressure_pa=float(declare(node, "run.pressure_pa", RunSpec.pressure_pa,
-                                    "constant profile pressure [Pa]")),
-        current_a=current if current >= 0 else math.nan,
-        file=str(declare(node, "run.file", "", "file profile: run (CSV or bag)")),
-        contact=str(declare(node, "run.contact", "auto", "auto | rig | actuator")),
-        duration_s=float(declare(node, "run.duration_s", 0.0, "input duration [s], 0: default")),
-        rate_hz=float(declare(node, "run.rate_hz", 0.0, "exchange rate [Hz], 0: from config")))
-
-
-def rig_and_run(node: Node) -> tuple[RigParameters, Scenario, bool]:
-    """Declare what every graph node shares: the model, the run and the clock.
-
-    Returns the parameter set, the run's scenario (its rate is the exchange rate) and
-    whether the graph runs in lockstep.
-    """
-    params = rig_parameters(node)
-    return params, load_scenario(run_spec(node), params), lockstep(node)
-
-
-def lockstep(node: Node) -> bool:
-    """Declare ``clock`` and say whether this graph runs in lockstep."""
-    clock = str(declare(node, "clock", "lockstep", "lockstep | realtime"))
-    if clock not in ("lockstep", "realtime"):
-        raise GraphError(f"clock must be lockstep or realtime, got {clock!r}")
-    return clock == "lockstep"
 
 
 def to_stamp(time_s: float) -> Time:
@@ -195,6 +141,12 @@ def say(node: Node, message: str) -> None:
         print(f"[{node.get_name()}] {message}", file=sys.stderr, flush=True)
 
 
+def relative(topic: str) -> str:
+    """A contract topic (``/rig/brake/pressure``) relative to the node's namespace
+    (``brake/pressure``), so that the namespace moves it; others (``/clock``) as they are."""
+    return topic.removeprefix(f"/{NAMESPACE}/")
+
+
 class RunFinishedError(Exception):
     """Raised inside the executor to leave spin() once a node's work is done."""
 
@@ -204,23 +156,27 @@ class GraphNode(Node):
 
     Subclasses override :meth:`pending` (work still due after the end, e.g. the
     recorder's last messages) and :meth:`close` (release files, always called).
+    Parameter services are served by :func:`spin` unless ``parameter_services`` is false.
     """
 
     def __init__(self, name: str) -> None:
-        # spin() serves no services: parameters are set at start (params file, -p)
-        super().__init__(name, start_parameter_services=False)
+        # ``-r __ns:=/rig2`` (or launch's namespace) moves the node and all its topics
+        super().__init__(name, namespace=NAMESPACE)
+        self.serves_parameters = bool(declare(
+            self, "parameter_services", True, "serve ros2 param (false: the last bit of "
+            "lockstep speed, no services)"))
         self.run_samples: int | None = None
         self.subscription(UInt64, TOPIC_RUN_END, self._on_run_end, LATCHED_QOS)
 
     def publisher(self, kind: Any, topic: str, qos: QoSProfile = DATA_QOS) -> Publisher:
         """A publisher without rclpy's default QoS-event handlers (each one is polled every
         executor wait; measured: they cost the graph a tenth of its step rate)."""
-        return self.create_publisher(kind, topic, qos, event_callbacks=_NO_PUB_EVENTS)
+        return self.create_publisher(kind, relative(topic), qos, event_callbacks=_NO_PUB_EVENTS)
 
     def subscription(self, kind: Any, topic: str, callback: Callable[[Any], None],
                      qos: QoSProfile = DATA_QOS, raw: bool = False) -> Subscription:
         """A subscription without the default QoS-event handlers (see :meth:`publisher`)."""
-        return self.create_subscription(kind, topic, callback, qos, raw=raw,
+        return self.create_subscription(kind, relative(topic), callback, qos, raw=raw,
                                         event_callbacks=_NO_SUB_EVENTS)
 
     def pending(self) -> bool:
@@ -239,6 +195,10 @@ class GraphNode(Node):
             raise RunFinishedError(self.get_name())
 
 
+SERVICE_POLL_S = 0.05
+"""How often :func:`spin` answers waiting service requests (``ros2 param``)."""
+
+
 def spin(node: Node) -> None:
     """Run the node's subscriptions and timers until shutdown (SIGINT/SIGTERM) or an error.
 
@@ -246,13 +206,17 @@ def spin(node: Node) -> None:
     subscriptions and timers, and every message waiting on a ready subscription taken in
     the same wake-up. rclpy's executor builds tasks and a wait set per callback; measured
     here, a two-process ping-pong ran 2900 round trips/s with it and 5400 with this loop.
-    Services are not served (the nodes run without parameter services by default).
+    Services (``ros2 param``, type descriptions) are answered from a second wait set polled
+    every :data:`SERVICE_POLL_S`, so the lockstep exchange does not pay for them per step.
     """
     context = node.context
     handle = context.handle
     if handle is None or not context.ok():  # a signal came while the node was being built
         return
     shutdown = SignalHandlerGuardCondition(context)
+    serve = not isinstance(node, GraphNode) or node.serves_parameters
+    wait_ns = round(SERVICE_POLL_S * 1e9) if serve else -1
+    polled = time.monotonic()
     node.get_logger().info("running (SIGINT or SIGTERM stops it)")
     try:
         while context.ok():
@@ -264,13 +228,33 @@ def spin(node: Node) -> None:
             for timer in timers:
                 wait_set.add_timer(timer.handle)
             wait_set.add_guard_condition(shutdown.handle)
-            wait_set.wait(-1)
+            wait_set.wait(wait_ns)
             if not context.ok():
                 raise ExternalShutdownException()
             _run_timers(timers, wait_set.get_ready_entities("timer"))
             _take_all(subscriptions, wait_set.get_ready_entities("subscription"))
+            if serve and time.monotonic() - polled >= SERVICE_POLL_S:
+                _answer(list(node.services), handle)
+                polled = time.monotonic()
     finally:
         shutdown.destroy()
+
+
+def _answer(services: list[Any], handle: Any) -> None:
+    """Answer every request waiting on ``services`` now (a wait set that does not block)."""
+    wait_set = _rclpy.WaitSet(0, 0, 0, 0, len(services), 0, handle)
+    for service in services:
+        wait_set.add_service(service.handle)
+    wait_set.wait(0)
+    ready = wait_set.get_ready_entities("service")
+    for service in services:
+        if service.handle.pointer not in ready:
+            continue
+        with service.handle:
+            request, header = service.handle.service_take_request(service.srv_type.Request)
+        if header is not None:
+            service.send_response(service.callback(request, service.srv_type.Response()),
+                                  header)
 
 
 def _run_timers(timers: list[Any], ready: list[int]) -> None:
@@ -302,6 +286,8 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None) -> int:
         if stop_requested():  # one came while the node was starting (see nodes/__init__)
             return 0
         node = factory()
+        check_overrides(node)
+        node.add_on_set_parameters_callback(lambda changes: refuse_changes(node, changes))
         spin(node)
     except (RunFinishedError, KeyboardInterrupt, ExternalShutdownException):
         pass

@@ -32,12 +32,11 @@ from landing_gear_sim.ros.nodes.common import (
     LATCHED_QOS,
     GraphNode,
     Handshake,
-    declare,
     main_for,
-    rig_and_run,
     step_of,
     to_stamp,
 )
+from landing_gear_sim.ros.nodes.parameters import declare, rig_and_run
 from msg_tools.contract import (
     ATMOSPHERE_PA,
     TOPIC_FLYWHEEL,

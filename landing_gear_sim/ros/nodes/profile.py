@@ -15,9 +15,9 @@ from landing_gear_sim.ros.nodes.common import (
     Handshake,
     announce_ready,
     main_for,
-    rig_and_run,
     step_of,
 )
+from landing_gear_sim.ros.nodes.parameters import rig_and_run
 from msg_tools.contract import TOPIC_CURRENT, TOPIC_WHEEL
 
 

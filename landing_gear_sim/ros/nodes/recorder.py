@@ -8,7 +8,8 @@ same bag files, whatever the machine load.
 
 The bag is written in segments (see :mod:`msg_tools.bag_segments`) of at least
 ``segment_s`` of sim time and ``segment_samples`` samples — a rule on the data, so the
-files are the same on every run. SIGINT/SIGTERM close the bag complete; after SIGKILL it
+files are the same on every run — and joined into one file when it closes
+(``join_segments``). SIGINT/SIGTERM close the bag complete; after SIGKILL it
 still opens and lacks only the open segment: about half a second of wall time at the
 graph's real-time factors (closing a segment costs ~30 ms, so at a high real-time factor
 the sample floor keeps the recorder from spending its time closing segments).
@@ -28,11 +29,11 @@ from landing_gear_sim.ros.nodes.common import (
     GraphNode,
     Handshake,
     announce_ready,
-    declare,
-    lockstep,
     main_for,
+    relative,
     say,
 )
+from landing_gear_sim.ros.nodes.parameters import check_overrides, declare, lockstep
 from msg_tools.bag_segments import SegmentedBagWriter
 from msg_tools.contract import TOPIC_CURRENT, TOPIC_TYPES, TOPIC_WHEEL
 
@@ -57,10 +58,17 @@ class RecorderNode(GraphNode):
                                                "segment [s]: the most a crash loses")) * 1e9)
         self._segment_samples = int(declare(self, "segment_samples", 500,
                                             "fewest samples per closed segment"))
+        join = bool(declare(self, "join_segments", True, "join the segments into one file "
+                            "when the bag closes (false: keep them)"))
         self._in_segment = 0
         if not path:
             raise GraphError("recorder needs the parameter bag:=FOLDER")
-        self._writer = SegmentedBagWriter(Path(path), TOPIC_TYPES, storage)
+        check_overrides(self)  # a typo must not leave an empty bag behind
+        # the bag holds the names the rig published under (``/rig2/...`` for a second rig)
+        self._names = {topic: self.resolve_topic_name(relative(topic)) for topic in TOPIC_TYPES}
+        self._writer = SegmentedBagWriter(
+            Path(path), {self._names[topic]: kind for topic, kind in TOPIC_TYPES.items()},
+            storage, join)
         self._samples: dict[int, dict[str, bytes]] = {}
         self._order: list[int] = []  # sample stamps in order (the wheel topic's arrival order)
         self._currents: list[bytes] = []
@@ -113,11 +121,11 @@ class RecorderNode(GraphNode):
             self._segment_start, self._in_segment = stamp, 0
         self._in_segment += 1
         if 0 < index <= len(self._currents):
-            self._writer.write(TOPIC_CURRENT, stamp, self._currents[index - 1])
+            self._writer.write(self._names[TOPIC_CURRENT], stamp, self._currents[index - 1])
         messages = self._samples.pop(stamp, {})
         for topic in SENSOR_TOPICS:
             if topic in messages:
-                self._writer.write(topic, stamp, messages[topic])
+                self._writer.write(self._names[topic], stamp, messages[topic])
         self._written += 1
 
     def pending(self) -> bool:

@@ -25,13 +25,10 @@ from landing_gear_sim.ros.nodes.common import (
     LATCHED_QOS,
     GraphNode,
     Handshake,
-    declare,
-    lockstep,
     main_for,
-    rig_parameters,
-    run_spec,
     to_stamp,
 )
+from landing_gear_sim.ros.nodes.parameters import declare, lockstep, rig_parameters, run_spec
 from landing_gear_sim.ros.nodes.profile import CurrentFeed
 from msg_tools.bag_io import TYPESTORE, contract_messages
 from msg_tools.contract import TOPIC_CURRENT, TOPIC_TYPES

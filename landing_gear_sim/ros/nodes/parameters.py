@@ -1,0 +1,146 @@
+"""The parameters of a graph node: declared with descriptors, checked against what the
+node and the graph know, and read once, when the run is built.
+
+``ros2 param list/get/describe`` answer (see :func:`common.spin`); ``ros2 param set`` is
+refused with one reason (:func:`refuse_changes`); a name nothing reads stops the node with
+the closest known one (:func:`check_overrides`).
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from typing import Any
+
+from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+from landing_gear_sim.errors import GraphError
+from landing_gear_sim.model.parameters import SPECS, RigParameters, load_parameters, spec_problem
+from landing_gear_sim.model.runspec import RunSpec
+from landing_gear_sim.model.scenario import Scenario
+from landing_gear_sim.ros.graph import load_scenario
+
+
+def declare(node: Node, name: str, default: Any, description: str) -> Any:
+    """Declare one parameter (any type a params file gives it) and return its value."""
+    descriptor = ParameterDescriptor(description=description, dynamic_typing=True)
+    return node.declare_parameter(name, default, descriptor).value
+
+
+def rig_parameters(node: Node) -> RigParameters:
+    """Declare every model parameter (bundled reference rig as default) and validate the set.
+
+    The params file of the graph (``--params-file config/reference_rig.yaml``, or the
+    calibrated one) overrides the defaults; so does ``-p key:=value``.
+    """
+    defaults = load_parameters()
+    values = {spec.key: declare(node, spec.key, defaults[spec.key],
+                                f"{spec.description} [{spec.unit}]") for spec in SPECS}
+    return RigParameters(values, ("node parameters",))
+
+
+RUN_PARAMETERS: dict[str, tuple[Any, str]] = {
+    "run.profile": ("constant", "current profile"),
+    "run.pressure_pa": (RunSpec.pressure_pa, "constant profile pressure [Pa]"),
+    "run.current_a": (-1.0, "constant profile current [A]; <0: from run.pressure_pa"),
+    "run.file": ("", "file profile: run (CSV or bag)"),
+    "run.contact": ("auto", "auto | rig | actuator"),
+    "run.duration_s": (0.0, "input duration [s], 0: default"),
+    "run.rate_hz": (0.0, "exchange rate [Hz], 0: from config"),
+}
+"""The ``run.*`` parameters (see graph.run_parameters): name -> (default, description)."""
+
+GRAPH_WIDE = frozenset({spec.key for spec in SPECS} | set(RUN_PARAMETERS)
+                       | {"clock", "parameter_services"})
+"""Parameters a params file may give every node (``/**``): not an error for a node that has
+no use for one (the recorder needs no friction curve)."""
+
+
+def run_spec(node: Node) -> RunSpec:
+    """Declare the ``run.*`` parameters and build the RunSpec."""
+    value = {name: declare(node, name, default, text)
+             for name, (default, text) in RUN_PARAMETERS.items()}
+    current = float(value["run.current_a"])
+    return RunSpec(profile=str(value["run.profile"]), pressure_pa=float(value["run.pressure_pa"]),
+                   current_a=current if current >= 0 else math.nan, file=str(value["run.file"]),
+                   contact=str(value["run.contact"]), duration_s=float(value["run.duration_s"]),
+                   rate_hz=float(value["run.rate_hz"]))
+
+
+def rig_and_run(node: Node) -> tuple[RigParameters, Scenario, bool]:
+    """Declare what every graph node shares: the model, the run and the clock.
+
+    Returns the parameter set, the run's scenario (its rate is the exchange rate) and
+    whether the graph runs in lockstep.
+    """
+    params = rig_parameters(node)
+    return params, load_scenario(run_spec(node), params), lockstep(node)
+
+
+def lockstep(node: Node) -> bool:
+    """Declare ``clock`` and say whether this graph runs in lockstep."""
+    clock = str(declare(node, "clock", "lockstep", "lockstep | realtime"))
+    if clock not in ("lockstep", "realtime"):
+        raise GraphError(f"clock must be lockstep or realtime, got {clock!r}")
+    return clock == "lockstep"
+
+
+SIM_TIME_REFUSED = ("use_sim_time must stay false: the graph publishes /clock itself and its "
+                    "nodes' timers are wall-clock (lockstep is driven by the data)")
+
+
+def check_overrides(node: Node) -> None:
+    """Refuse a parameter given to ``node`` (``-p``, a params file) that nothing reads.
+
+    rclpy drops an override it has no declaration for; a typo (``run.profil``) would then
+    silently run the default.
+
+    Raises:
+        GraphError: the first unknown name, with the closest known one.
+    """
+    if node.get_parameter("use_sim_time").value:
+        raise GraphError(SIM_TIME_REFUSED)
+    # rclpy keeps the overrides of this node (its own and ``/**`` sections) only here
+    given = getattr(node, "_parameter_overrides", {})
+    for name in sorted(given):
+        if not (node.has_parameter(name) or name in GRAPH_WIDE):
+            known = set(node.list_parameters([], 0).names) | GRAPH_WIDE
+            hint = difflib.get_close_matches(name, sorted(known), n=1)
+            suggestion = f" (did you mean {hint[0]!r}?)" if hint else ""
+            raise GraphError(f"unknown parameter {name!r}{suggestion}")
+
+
+def refuse_changes(node: Node, changes: list[Parameter]) -> SetParametersResult:
+    """``ros2 param set``: a node's parameters are read once, when its run is built, so a
+    change is refused, with the reason; a bad value is named as such first."""
+    if not changes:
+        return SetParametersResult(successful=True)
+    change = changes[0]
+    reason = _value_problem(node, change) or (
+        f"{change.name} is read when the run starts; restart the node with "
+        f"-p {change.name}:={_as_text(change.value)} (or in its params file)")
+    return SetParametersResult(successful=False, reason=reason)
+
+
+def _value_problem(node: Node, change: Parameter) -> str | None:
+    if change.name == "use_sim_time" and change.value:
+        return SIM_TIME_REFUSED
+    if change.name in {spec.key for spec in SPECS}:
+        problem = spec_problem(change.name, change.value)
+        return f"{change.name} {problem}" if problem else None
+    current = node.get_parameter(change.name).value
+    if type(change.value) is not type(current) and not (
+            isinstance(current, float) and type(change.value) is int):
+        return (f"{change.name} must be a {type(current).__name__}, got "
+                f"{_as_text(change.value)}")
+    return None
+
+
+def _as_text(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return repr(value)
+    return str(list(value)) if isinstance(value, (list, tuple)) else str(value)

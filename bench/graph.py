@@ -55,6 +55,7 @@ def realtime_periods(duration_s: float) -> tuple[float, float, float]:
     from sensor_msgs.msg import JointState
 
     from landing_gear_sim.ros.nodes.common import spin
+    from msg_tools.contract import TOPIC_WHEEL
 
     rclpy.init()
     node = rclpy.create_node("bench_listener", start_parameter_services=False)
@@ -65,8 +66,7 @@ def realtime_periods(duration_s: float) -> tuple[float, float, float]:
         arrivals.append(time.monotonic())
         stamps.append(message.header.stamp.sec + message.header.stamp.nanosec * 1e-9)
 
-    node.create_subscription(JointState, "/rig/wheel/joint_state",
-                             heard,
+    node.create_subscription(JointState, TOPIC_WHEEL, heard,
                              QoSProfile(depth=5000, reliability=ReliabilityPolicy.RELIABLE))
     graph = subprocess.Popen(
         [sys.executable, "-m", "landing_gear_sim", "rig", "--profile", "sweep", "--duration",

@@ -179,7 +179,12 @@ def cmd_rig(args: argparse.Namespace) -> int:
                 else "stopped before anything was recorded")
         print(f"{PROG}: interrupted; {held}", file=sys.stderr)
         return 130
-    return 0 if outcome.ok else 1
+    if not outcome.ok:
+        print(f"{PROG}: error: the run failed (plant exit code "
+              f"{outcome.exit_codes.get('plant')}; a lost node's input was held, see above)",
+              file=sys.stderr)
+        return 1
+    return 0
 
 
 def _bag_summary(bag: Path) -> str:

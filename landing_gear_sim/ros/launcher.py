@@ -106,13 +106,13 @@ def _run_processes(options: GraphOptions, params_file: Path,
 
 
 def _node_process() -> None:
-    """How a node process starts: it dies with the launcher, and with SIGINT and SIGTERM
-    ignored until its package takes them (``ros/nodes/__init__``). Python's own SIGINT
-    handler made a terminal's Ctrl-C in a node's first milliseconds a KeyboardInterrupt
-    traceback; a signal ignored there is not lost, since :func:`_stop` repeats it."""
+    """How a node process starts: it dies with the launcher, and with SIGINT ignored until
+    its package takes it (``ros/nodes/__init__``). Python's own SIGINT handler made a
+    terminal's Ctrl-C in a node's first milliseconds a KeyboardInterrupt traceback; a SIGINT
+    ignored there is not lost, since :func:`_stop` repeats it. SIGTERM keeps its default
+    there (the process just ends): the launcher's death must still end the node."""
     die_with_parent()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)
 
 
 def _interrupt(signum: int, frame: object) -> None:

@@ -166,6 +166,7 @@ class GraphNode(Node):
             self, "parameter_services", True, "serve ros2 param (false: the last bit of "
             "lockstep speed, no services)"))
         self.run_samples: int | None = None
+        self.exit_code = 0  # what the process exits with once the run is over
         self.subscription(UInt64, TOPIC_RUN_END, self._on_run_end, LATCHED_QOS)
 
     def publisher(self, kind: Any, topic: str, qos: QoSProfile = DATA_QOS) -> Publisher:
@@ -308,7 +309,7 @@ def run_node(factory: Callable[[], Node], args: list[str] | None = None) -> int:
         # must not kill the exit, which Python makes with default handlers (exit -2)
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
-    return 0
+    return node.exit_code if isinstance(node, GraphNode) else 0
 
 
 def _program() -> str:

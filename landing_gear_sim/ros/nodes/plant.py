@@ -48,6 +48,8 @@ from msg_tools.units import PA_PER_BAR
 
 ACTUATOR, LOADING = "actuator", "loading_device"
 LOST_CHUNK = 500  # steps per watchdog tick once every input is lost: keep the executor responsive
+LOST_PEER_EXIT = 3
+"""Exit code of a plant whose run lost a participant (held its input): never a success."""
 
 
 class PlantNode(GraphNode):
@@ -186,6 +188,11 @@ class PlantNode(GraphNode):
                                f"{wall:.2f} s wall: real-time factor {sim / max(wall, 1e-9):.2f}")
         if len(self._published_at) > 2:
             self.get_logger().info(self._pacing_report())
+        if self._lost:
+            # the run went on so the bag is complete, but it is not the run that was asked
+            self.exit_code = LOST_PEER_EXIT
+            self.get_logger().error(f"run completed without input from "
+                                    f"{', '.join(sorted(self._lost))} (held from the loss on)")
         self._end.publish(UInt64(data=samples))
 
     def _pacing_report(self) -> str:

@@ -24,6 +24,7 @@ from landing_gear_sim.ros.graph import GraphOptions, NodeSpec, ParamValue, descr
 LINGER_S = 10.0  # after the plant ends, how long the others may take to finish on their own
 STOP_S = 5.0  # after SIGINT, how long before SIGKILL
 RESEND_S = 0.5  # SIGINT repeated this often while a node still runs
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 def ros_environment(environ: dict[str, str] | None = None) -> dict[str, str]:
@@ -89,11 +90,18 @@ def _run_processes(options: GraphOptions, params_file: Path,
     interrupted = False
     # SIGINT too: a shell starts a background job with SIGINT ignored, and the nodes would
     # stop on the terminal's Ctrl-C while the launcher reported a complete run
-    previous = {sig: signal.signal(sig, _interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
+    previous = {sig: signal.signal(sig, _interrupt) for sig in STOP_SIGNALS}
     try:
         for node in nodes:
-            processes[node.name] = subprocess.Popen(node_command(node, params_file), env=env,
-                                                    preexec_fn=_node_process)
+            # a signal during fork ran our handler inside an at-fork hook, which swallows
+            # exceptions: the launcher missed the stop (seen: 5 in 15 group SIGTERMs). Held
+            # here, it is delivered after the fork, to ordinary code.
+            signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
+            try:
+                processes[node.name] = subprocess.Popen(
+                    node_command(node, params_file), env=env, preexec_fn=_node_process)
+            finally:
+                signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)
         _wait_for_plant(processes, say)
         _wait_all(processes, LINGER_S)
     except KeyboardInterrupt:
@@ -113,6 +121,8 @@ def _node_process() -> None:
     there (the process just ends): the launcher's death must still end the node."""
     die_with_parent()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # not the launcher's handler
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)  # the mask survives exec
 
 
 def _interrupt(signum: int, frame: object) -> None:

@@ -24,7 +24,7 @@ from landing_gear_sim.ros.graph import GraphOptions, NodeSpec, ParamValue, descr
 LINGER_S = 10.0  # after the plant ends, how long the others may take to finish on their own
 STOP_S = 5.0  # after SIGINT, how long before SIGKILL
 RESEND_S = 0.5  # SIGINT repeated this often while a node still runs
-STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)  # both stop the graph; the bag is closed
 
 
 def ros_environment(environ: dict[str, str] | None = None) -> dict[str, str]:
@@ -87,51 +87,57 @@ def _run_processes(options: GraphOptions, params_file: Path,
     say(f"starting {', '.join(n.name for n in nodes)} (ROS_DOMAIN_ID {domain}, discovery "
         f"{discovery})")
     processes: dict[str, subprocess.Popen] = {}
-    interrupted = False
     # SIGINT too: a shell starts a background job with SIGINT ignored, and the nodes would
     # stop on the terminal's Ctrl-C while the launcher reported a complete run
-    previous = {sig: signal.signal(sig, _interrupt) for sig in STOP_SIGNALS}
+    stop = StopRequest()
+    previous = {sig: signal.signal(sig, stop) for sig in STOP_SIGNALS}
     try:
         for node in nodes:
-            # a signal during fork ran our handler inside an at-fork hook, which swallows
-            # exceptions: the launcher missed the stop (seen: 5 in 15 group SIGTERMs). Held
-            # here, it is delivered after the fork, to ordinary code.
-            signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
-            try:
-                processes[node.name] = subprocess.Popen(
-                    node_command(node, params_file), env=env, preexec_fn=_node_process)
-            finally:
-                signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)
-        _wait_for_plant(processes, say)
-        _wait_all(processes, LINGER_S)
-    except KeyboardInterrupt:
-        interrupted = True
+            if stop.requested:
+                break
+            processes[node.name] = subprocess.Popen(node_command(node, params_file), env=env,
+                                                    preexec_fn=_node_process)
+        _wait_for_plant(processes, say, stop)
+        _wait_all(processes, LINGER_S, stop)
     finally:
+        _stop(processes)  # a second Ctrl-C meanwhile is only noted: the bag is being closed
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-        _stop(processes)
-    return Outcome(_codes(processes), interrupted)
+    return Outcome(_codes(processes), stop.requested)
+
+
+class StopRequest:
+    """The launcher's SIGINT/SIGTERM handler: it notes the stop, the wait loops act on it.
+
+    It once raised KeyboardInterrupt instead. A signal that came while a node was being
+    forked then ran it inside an at-fork hook, where CPython prints and swallows the
+    exception ("Exception ignored in _releaseLock"): the launcher missed the stop (5 of 15
+    group SIGTERMs at start-up), or it came inside Popen and the forked node was never
+    recorded (an orphan). Noting a flag is safe anywhere.
+    """
+
+    def __init__(self) -> None:
+        self.requested = False
+
+    def __call__(self, signum: int, frame: object) -> None:
+        self.requested = True
 
 
 def _node_process() -> None:
     """How a node process starts: it dies with the launcher, and with SIGINT ignored until
     its package takes it (``ros/nodes/__init__``). Python's own SIGINT handler made a
     terminal's Ctrl-C in a node's first milliseconds a KeyboardInterrupt traceback; a SIGINT
-    ignored there is not lost, since :func:`_stop` repeats it. SIGTERM keeps its default
-    there (the process just ends): the launcher's death must still end the node."""
+    ignored there is not lost, since :func:`_stop` repeats it. SIGTERM gets its default
+    back (the process just ends): the launcher's death must still end the node."""
     die_with_parent()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # not the launcher's handler
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)  # the mask survives exec
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
-def _interrupt(signum: int, frame: object) -> None:
-    raise KeyboardInterrupt  # SIGTERM stops the graph like Ctrl-C: the bag is closed
-
-
-def _wait_for_plant(processes: dict[str, subprocess.Popen], say: Callable[[str], None]) -> None:
+def _wait_for_plant(processes: dict[str, subprocess.Popen], say: Callable[[str], None],
+                    stop: StopRequest) -> None:
     reported: set[str] = set()
-    while processes["plant"].poll() is None:
+    while "plant" in processes and processes["plant"].poll() is None and not stop.requested:
         for name, process in processes.items():
             code = process.poll()
             if code is None or name in reported:
@@ -144,9 +150,11 @@ def _wait_for_plant(processes: dict[str, subprocess.Popen], say: Callable[[str],
         time.sleep(0.05)
 
 
-def _wait_all(processes: dict[str, subprocess.Popen], timeout_s: float) -> None:
+def _wait_all(processes: dict[str, subprocess.Popen], timeout_s: float,
+              stop: StopRequest | None = None) -> None:
     deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline and any(p.poll() is None for p in processes.values()):
+    while (time.monotonic() < deadline and any(p.poll() is None for p in processes.values())
+           and not (stop and stop.requested)):
         time.sleep(0.05)
 
 

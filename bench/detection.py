@@ -137,15 +137,19 @@ def run_case(cause: str | None, seed: int, datasheet: RigParameters) -> tuple[bo
             result.verdict == "discovered" else result.verdict
         if result.verdict != "discovered" or not found:
             return False, verdict, math.nan
-        value, truth = found[0].parameters[case.key], case.truth(rig)
-        error = abs(value - truth) if case.absolute else abs(value / truth - 1.0)
-        return error <= case.tolerance, verdict, error
+        return _within(case, found[0].parameters[case.key], rig, verdict)
     found = [f for f in result.findings if f.cause == cause]
     if result.verdict != cause or not found:
         return False, result.verdict, math.nan
-    value, truth = found[0].parameters[case.key], case.truth(rig)
+    return _within(case, found[0].parameters[case.key], rig, result.verdict)
+
+
+def _within(case: Case, value: float, rig: RigParameters, verdict: str
+            ) -> tuple[bool, str, float]:
+    """(key parameter within the case's tolerance, verdict, its error)."""
+    truth = case.truth(rig)
     error = abs(value - truth) if case.absolute else abs(value / truth - 1.0)
-    return error <= case.tolerance, result.verdict, error
+    return error <= case.tolerance, verdict, error
 
 
 def case_task(cause: str | None, seed: int) -> dict:

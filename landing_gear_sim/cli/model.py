@@ -144,7 +144,12 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def cmd_rig(args: argparse.Namespace) -> int:
-    from landing_gear_sim.ros.graph import GraphOptions, controlled_run, load_scenario
+    from landing_gear_sim.ros.graph import (
+        LOST_PEER_EXIT,
+        GraphOptions,
+        controlled_run,
+        load_scenario,
+    )
     from landing_gear_sim.ros.launcher import run_graph
 
     params = params_of(args)
@@ -171,18 +176,18 @@ def cmd_rig(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - started
     print(f"graph run: {wall:.1f} s wall; node exit codes: "
           + ", ".join(f"{name} {code}" for name, code in outcome.exit_codes.items()))
-    recorded = bag is not None and bag.exists()
-    if bag is not None and recorded:
-        print(_bag_summary(bag))
+    recorded = bag if bag is not None and bag.exists() else None
+    if recorded is not None:
+        print(_bag_summary(recorded))
     if outcome.interrupted:
-        held = ("the bag holds the run up to the stop" if recorded
+        held = ("the bag holds the run up to the stop" if recorded is not None
                 else "stopped before anything was recorded")
         print(f"{PROG}: interrupted; {held}", file=sys.stderr)
         return 130
     if not outcome.ok:
-        print(f"{PROG}: error: the run failed (plant exit code "
-              f"{outcome.exit_codes.get('plant')}; a lost node's input was held, see above)",
-              file=sys.stderr)
+        code = outcome.exit_codes.get("plant")
+        why = "; a lost node's input was held, see above" if code == LOST_PEER_EXIT else ""
+        print(f"{PROG}: error: the run failed (plant exit code {code}{why})", file=sys.stderr)
         return 1
     return 0
 

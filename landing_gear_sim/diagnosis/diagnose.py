@@ -219,7 +219,9 @@ def _discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: Ri
     if lags:
         scored = _score_discovered(skew_candidate(lags[0]), runs, model, datasheet, scales,
                                    signatures, say)
-    braking = [br.prepare(r, model) for r in runs if r.braking]
+    libraries = {FREE_ROLLING, GAIN_IN_SPEED, GAIN_IN_PRESSURE}  # relations they explain
+    # filtered once for both libraries, and only when one of them will be asked
+    braking = [br.prepare(r, model) for r in runs if r.braking] if broken & libraries else []
     if FREE_ROLLING in broken and (scored is None or not scored.finding.accepted):
         channels = select_channel_terms(runs, braking, model)
         if channels:

@@ -44,6 +44,8 @@ SENSOR_TOPICS = (TOPIC_WHEEL, TOPIC_FLYWHEEL, TOPIC_PRESSURE, TOPIC_WRENCH)
 RECORDED_TOPICS = (TOPIC_CURRENT, *SENSOR_TOPICS)
 
 CONTROLLER_NODE = "antiskid_controller"
+LOST_PEER_EXIT = 3
+"""Exit code of a plant whose run lost a participant (held its input): never a success."""
 NAMESPACE_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*")
 """A ROS namespace without its leading '/' (what ``-r __ns:=/...`` and launch accept)."""
 CLOCKS = ("lockstep", "realtime")
@@ -182,28 +184,28 @@ def run_parameters(run: RunSpec) -> dict[str, ParamValue]:
 def describe(options: GraphOptions) -> list[NodeSpec]:
     """The nodes of the graph for ``options``, plant first, with their expected links."""
     run = run_parameters(options.run)
-    clock: dict[str, ParamValue] = {"clock": options.clock}
+    shared: dict[str, ParamValue] = {"clock": options.clock}  # every node's
     if not options.parameter_services:
-        clock["parameter_services"] = False
+        shared["parameter_services"] = False
     nodes = [
-        NodeSpec("plant", {**run, **clock, "sensor_noise": options.sensor_noise,
+        NodeSpec("plant", {**run, **shared, "sensor_noise": options.sensor_noise,
                            "timeout_s": options.timeout_s,
                            "safe_pressure_pa": options.safe_pressure_pa},
                  (*SENSOR_TOPICS, TOPIC_CLOCK, TOPIC_RUN_END), (TOPIC_HYDRAULIC, TOPIC_LOAD)),
-        NodeSpec("actuator", {**run, **clock}, (TOPIC_HYDRAULIC,), (TOPIC_CURRENT,)),
-        NodeSpec("loading_device", {**run, **clock}, (TOPIC_LOAD,), (TOPIC_FLYWHEEL,)),
+        NodeSpec("actuator", {**run, **shared}, (TOPIC_HYDRAULIC,), (TOPIC_CURRENT,)),
+        NodeSpec("loading_device", {**run, **shared}, (TOPIC_LOAD,), (TOPIC_FLYWHEEL,)),
     ]
     if options.controller:
-        nodes.append(NodeSpec(CONTROLLER_NODE, {**run, **clock, "type": options.controller},
+        nodes.append(NodeSpec(CONTROLLER_NODE, {**run, **shared, "type": options.controller},
                               (TOPIC_CURRENT,), (TOPIC_WHEEL, TOPIC_FLYWHEEL)))
     elif options.replay:
-        nodes.append(NodeSpec("replay", {**run, **clock, "topics": "current",
+        nodes.append(NodeSpec("replay", {**run, **shared, "topics": "current",
                                          "file": options.run.file},
                               (TOPIC_CURRENT,), (TOPIC_WHEEL,)))
     else:
-        nodes.append(NodeSpec("profile", {**run, **clock}, (TOPIC_CURRENT,), (TOPIC_WHEEL,)))
+        nodes.append(NodeSpec("profile", {**run, **shared}, (TOPIC_CURRENT,), (TOPIC_WHEEL,)))
     if options.bag is not None:
-        nodes.append(NodeSpec("recorder", {**clock, "bag": str(options.bag),
+        nodes.append(NodeSpec("recorder", {**shared, "bag": str(options.bag),
                                            "storage": options.storage},
                               (), RECORDED_TOPICS))
     return [replace(node, namespace=options.namespace) for node in _with_links(nodes)]

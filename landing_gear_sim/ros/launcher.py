@@ -137,7 +137,7 @@ def _node_process() -> None:
 def _wait_for_plant(processes: dict[str, subprocess.Popen], say: Callable[[str], None],
                     stop: StopRequest) -> None:
     reported: set[str] = set()
-    while "plant" in processes and processes["plant"].poll() is None and not stop.requested:
+    while not stop.requested and processes["plant"].poll() is None:
         for name, process in processes.items():
             code = process.poll()
             if code is None or name in reported:

@@ -17,10 +17,16 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from landing_gear_sim.errors import GraphError
-from landing_gear_sim.model.parameters import SPECS, RigParameters, load_parameters, spec_problem
+from landing_gear_sim.model.parameters import (
+    INDEX,
+    SPECS,
+    RigParameters,
+    load_parameters,
+    spec_problem,
+)
 from landing_gear_sim.model.runspec import RunSpec
 from landing_gear_sim.model.scenario import Scenario
-from landing_gear_sim.ros.graph import load_scenario
+from landing_gear_sim.ros.graph import CLOCKS, load_scenario
 
 
 def declare(node: Node, name: str, default: Any, description: str) -> Any:
@@ -52,8 +58,7 @@ RUN_PARAMETERS: dict[str, tuple[Any, str]] = {
 }
 """The ``run.*`` parameters (see graph.run_parameters): name -> (default, description)."""
 
-GRAPH_WIDE = frozenset({spec.key for spec in SPECS} | set(RUN_PARAMETERS)
-                       | {"clock", "parameter_services"})
+GRAPH_WIDE = frozenset(INDEX) | set(RUN_PARAMETERS) | {"clock", "parameter_services"}
 """Parameters a params file may give every node (``/**``): not an error for a node that has
 no use for one (the recorder needs no friction curve)."""
 
@@ -82,7 +87,7 @@ def rig_and_run(node: Node) -> tuple[RigParameters, Scenario, bool]:
 def lockstep(node: Node) -> bool:
     """Declare ``clock`` and say whether this graph runs in lockstep."""
     clock = str(declare(node, "clock", "lockstep", "lockstep | realtime"))
-    if clock not in ("lockstep", "realtime"):
+    if clock not in CLOCKS:
         raise GraphError(f"clock must be lockstep or realtime, got {clock!r}")
     return clock == "lockstep"
 
@@ -127,7 +132,7 @@ def refuse_changes(node: Node, changes: list[Parameter]) -> SetParametersResult:
 def _value_problem(node: Node, change: Parameter) -> str | None:
     if change.name == "use_sim_time" and change.value:
         return SIM_TIME_REFUSED
-    if change.name in {spec.key for spec in SPECS}:
+    if change.name in INDEX:
         problem = spec_problem(change.name, change.value)
         return f"{change.name} {problem}" if problem else None
     current = node.get_parameter(change.name).value

@@ -21,6 +21,7 @@ from std_msgs.msg import String, UInt64
 
 from landing_gear_sim.model.blocks import PlantBlock, SensorSample
 from landing_gear_sim.ros.graph import (
+    LOST_PEER_EXIT,
     TOPIC_CLOCK,
     TOPIC_HYDRAULIC,
     TOPIC_LOAD,
@@ -48,8 +49,6 @@ from msg_tools.units import PA_PER_BAR
 
 ACTUATOR, LOADING = "actuator", "loading_device"
 LOST_CHUNK = 500  # steps per watchdog tick once every input is lost: keep the executor responsive
-LOST_PEER_EXIT = 3
-"""Exit code of a plant whose run lost a participant (held its input): never a success."""
 
 
 class PlantNode(GraphNode):

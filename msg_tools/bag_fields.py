@@ -13,25 +13,27 @@ differentiates.
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
 
 from .contract import (
     ATMOSPHERE_PA,
+    LEGACY_CURRENT_TYPE,
     NAMESPACE,
     TOPIC_CURRENT,
     TOPIC_FLYWHEEL,
     TOPIC_PRESSURE,
     TOPIC_WHEEL,
     TOPIC_WRENCH,
+    VALVE_JOINT,
 )
 from .errors import RunFormatError
 from .mapping import Channel
 
 CONTRACT_SOURCES: dict[str, tuple[str, str]] = {
-    "current_ref_A": (TOPIC_CURRENT, "data"),
+    "current_ref_A": (TOPIC_CURRENT, f"effort[{VALVE_JOINT}]"),
     "brake_pressure_bar": (TOPIC_PRESSURE, "fluid_pressure"),
     "wheel_speed_rad_s": (TOPIC_WHEEL, "velocity[wheel]"),
     "flywheel_speed_rad_s": (TOPIC_FLYWHEEL, "velocity[flywheel]"),
@@ -39,6 +41,8 @@ CONTRACT_SOURCES: dict[str, tuple[str, str]] = {
     "longitudinal_force_N": (TOPIC_WRENCH, "wrench.force.x"),
 }
 """Contract column → (contract topic, field)."""
+LEGACY_FIELDS: dict[tuple[str, str], str] = {("current_ref_A", LEGACY_CURRENT_TYPE): "data"}
+"""(contract column, message type) → field, for the types of 0.1 bags."""
 
 _STEP = re.compile(r"(\w+)(?:\[(\w+)\])?")
 
@@ -97,8 +101,14 @@ class Source:
     channel: Channel
 
 
-def resolve(mapping: dict[str, Channel], topics: Sequence[str], where: str) -> list[Source]:
-    """The bag source of each contract column except time (the wheel's stamps)."""
+def resolve(mapping: dict[str, Channel], types: Mapping[str, str], where: str) -> list[Source]:
+    """The bag source of each contract column except time (the wheel's stamps).
+
+    Args:
+        types: message type of each topic in the bag (``{"/rig/brake/pressure":
+            "sensor_msgs/msg/FluidPressure"}``).
+    """
+    topics = sorted(types)
     sources = []
     for contract, (default_topic, default_field) in CONTRACT_SOURCES.items():
         channel = mapping[contract]
@@ -106,8 +116,8 @@ def resolve(mapping: dict[str, Channel], topics: Sequence[str], where: str) -> l
         if topic not in topics:
             raise RunFormatError(f"{where}: bag has no topic {topic} (for {contract}; topics: "
                                  f"{', '.join(topics)})")
-        sources.append(Source(contract, topic, FieldPath(channel.field or default_field),
-                              channel))
+        field = channel.field or LEGACY_FIELDS.get((contract, types[topic]), default_field)
+        sources.append(Source(contract, topic, FieldPath(field), channel))
     return sources
 
 

@@ -20,6 +20,7 @@ from .contract import (
     TOPIC_TYPES,
     TOPIC_WHEEL,
     TOPIC_WRENCH,
+    VALVE_JOINT,
 )
 from .errors import RunFormatError
 from .run import Run
@@ -55,7 +56,9 @@ def contract_messages(run: Run, k: int) -> dict[str, Any]:
         force=vector(x=float(run.longitudinal_force_n[k]), y=0.0, z=float(run.vertical_load_n[k])),
         torque=vector(x=0.0, y=0.0, z=0.0))
     return {
-        TOPIC_CURRENT: types["std_msgs/msg/Float64"](data=float(run.current_a[k])),
+        TOPIC_CURRENT: types["sensor_msgs/msg/JointState"](
+            header=_header(t, VALVE_JOINT), name=[VALVE_JOINT], position=empty, velocity=empty,
+            effort=np.array([float(run.current_a[k])])),
         TOPIC_PRESSURE: types["sensor_msgs/msg/FluidPressure"](
             header=_header(t, "brake"), fluid_pressure=float(run.pressure_pa[k]) + ATMOSPHERE_PA,
             variance=0.0),

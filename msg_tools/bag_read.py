@@ -3,7 +3,8 @@
 Messages are streamed: each is reduced to its stamp and the numbers the run needs as it is
 read (``array('d')``), so memory grows with the samples kept, not with the messages
 decoded. Stamped topics are matched to the wheel encoder's stamps by linear interpolation,
-the current command by log time (held, as the valve sees it).
+the current command by its stamp (the end of the interval it holds for), or a 0.1
+bag's ``Float64`` current by log time, held as the valve sees it.
 """
 
 from __future__ import annotations
@@ -51,6 +52,7 @@ class _Series:
     time_s: array = field(default_factory=lambda: array("d"))
     values: array = field(default_factory=lambda: array("d"))
     positions: bool = False
+    stamped: bool = False  # header stamps, not log times
 
 
 def read_bag(path: Path, name: str | None = None, mapping: Mapping | None = None) -> Run:
@@ -59,8 +61,8 @@ def read_bag(path: Path, name: str | None = None, mapping: Mapping | None = None
     where = str(path)
     try:
         with AnyReader(bag_paths(path), default_typestore=TYPESTORE) as reader:
-            topics = sorted({c.topic for c in reader.connections})
-            sources = resolve(mapping or DEFAULT_MAPPING, topics, where)
+            types = {c.topic: c.msgtype for c in reader.connections}
+            sources = resolve(mapping or DEFAULT_MAPPING, types, where)
             series = _stream(reader, sources)
     except RunFormatError:
         raise
@@ -80,7 +82,7 @@ def _stream(reader: AnyReader, sources: list[Source]) -> dict[str, _Series]:
     for connection, log_time, raw in reader.messages(connections=wanted):
         message = reader.deserialize(raw, connection.msgtype)
         for source in by_topic[connection.topic]:
-            stamp = _stamp_s(message, log_time, stamped=source.contract != "current_ref_A")
+            stamp, stamped = _stamp_s(message, log_time)
             try:
                 value, position = source.field.read(message)
             except (AttributeError, IndexError, TypeError) as exc:
@@ -90,14 +92,16 @@ def _stream(reader: AnyReader, sources: list[Source]) -> dict[str, _Series]:
             target.time_s.append(stamp)
             target.values.append(value)
             target.positions |= position
+            target.stamped |= stamped
     return series
 
 
-def _stamp_s(message: Any, log_time_ns: int, stamped: bool) -> float:
+def _stamp_s(message: Any, log_time_ns: int) -> tuple[float, bool]:
+    """(the header stamp, True), or (the log time, False) for a message without one."""
     header = getattr(message, "header", None)
-    if stamped and header is not None and (header.stamp.sec or header.stamp.nanosec):
-        return header.stamp.sec + header.stamp.nanosec * 1e-9
-    return log_time_ns * 1e-9
+    if header is not None and (header.stamp.sec or header.stamp.nanosec):
+        return header.stamp.sec + header.stamp.nanosec * 1e-9, True
+    return log_time_ns * 1e-9, False
 
 
 def _on_wheel_base(series: dict[str, _Series], sources: list[Source], where: str
@@ -112,6 +116,20 @@ def _on_wheel_base(series: dict[str, _Series], sources: list[Source], where: str
     return fields
 
 
+def _command_in_force(times: np.ndarray, base: np.ndarray, stamped: bool) -> np.ndarray:
+    """Index of the command in force over the interval that ends at each ``base`` time.
+
+    A stamped command ends its interval at its stamp (the first stamp at or after t);
+    a command known only by its log time (0.1's Float64) holds from then on (the last at
+    or before t). The first rows take the first command, the last rows keep the last.
+    """
+    if stamped:
+        index = np.searchsorted(times, base - 1e-6, side="left")
+    else:
+        index = np.searchsorted(times, base + 1e-6, side="right") - 1
+    return np.clip(index, 0, times.size - 1)
+
+
 def _column(series: _Series, source: Source, base: np.ndarray) -> np.ndarray:
     times = np.asarray(series.time_s)
     channel = source.channel
@@ -120,6 +138,5 @@ def _column(series: _Series, source: Source, base: np.ndarray) -> np.ndarray:
     if series.positions:
         values = speed_from_angle(times, values)
     if source.contract == "current_ref_A":
-        held = np.searchsorted(times, base + 1e-9, side="right") - 1
-        return values[np.clip(held, 0, None)]
+        return values[_command_in_force(times, base, series.stamped)]
     return np.interp(base, times, values)

@@ -33,6 +33,12 @@ CSV_TO_FIELD: dict[str, str] = {
 """CSV column → :class:`msg_tools.run.Run` field."""
 
 TOPIC_CURRENT = "/rig/brake/current_ref"
+"""The brake command: a ``sensor_msgs/JointState`` whose joint :data:`VALVE_JOINT` carries
+the valve current [A] in ``effort``; its stamp is the *end* of the interval the current
+holds for (from the previous command's stamp, or the run's start). A CSV row at t holds
+the same command. 0.1 bags carry it as ``std_msgs/Float64`` at its log time."""
+VALVE_JOINT = "brake_valve"
+LEGACY_CURRENT_TYPE = "std_msgs/msg/Float64"
 TOPIC_PRESSURE = "/rig/brake/pressure"
 # the speeds were on .../joint_state in 0.1; readers still take bags with those names
 TOPIC_WHEEL = "/rig/wheel/joint_states"
@@ -44,7 +50,7 @@ NAMESPACE = "rig"
 started in another namespace, ``/rig2``, publishes ``/rig2/brake/pressure``)."""
 
 TOPIC_TYPES: dict[str, str] = {
-    TOPIC_CURRENT: "std_msgs/msg/Float64",
+    TOPIC_CURRENT: "sensor_msgs/msg/JointState",
     TOPIC_PRESSURE: "sensor_msgs/msg/FluidPressure",
     TOPIC_WHEEL: "sensor_msgs/msg/JointState",
     TOPIC_FLYWHEEL: "sensor_msgs/msg/JointState",

@@ -10,6 +10,7 @@ os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ["ROS_DOMAIN_ID"] = str(1 + os.getpid() % 100)
 
 import pytest
+from graph_support import start  # noqa: F401  # the graph tests' launcher fixture
 
 from landing_gear_sim.model.parameters import RigParameters, load_parameters
 

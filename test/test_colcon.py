@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from graph_support import SHORT
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE_FILES = ("package.xml", "setup.py", "setup.cfg", "README.md", "colcon.pkg", "resource",
@@ -109,7 +110,6 @@ REAL_ROS2 = shutil.which("ros2")
 needs_ros2 = pytest.mark.skipif(
     REAL_ROS2 is None, reason="the real ros2/launch_ros tools are not on PATH (build them "
     "with ../shared/tools/rosenv-recipe.sh; CI cannot)")
-SHORT = {"rig_test.brake_start_s": 0.3, "rig_test.max_duration_s": 1.5}
 NODES = ("plant", "actuator", "loading_device", "profile", "recorder")
 
 
@@ -127,8 +127,9 @@ def _ros(workspace: Path, command: str, timeout: float = 120) -> tuple[int, str]
 
 
 def _param(verb: str, arguments: str) -> str:
-    # a discovery of its own: a daemon started moments ago does not know every node yet
-    return f"ros2 param {verb} --no-daemon --spin-time 3 {arguments}"
+    # a discovery of its own: a daemon started moments ago does not know every node yet;
+    # 6 s: beside a lockstep rig using both cores, 3 s missed a node now and then
+    return f"ros2 param {verb} --no-daemon --spin-time 6 {arguments}"
 
 
 @pytest.fixture
@@ -167,14 +168,37 @@ def test_ros2_launch_takes_every_argument(workspace, tmp_path, short_params, arg
 
 
 @needs_ros2
+def test_ros2_launch_with_an_external_controller_runs_the_example_node(workspace, tmp_path,
+                                                                      short_params):
+    from msg_tools.bag_read import read_bag
+
+    bag = tmp_path / "bag"
+    launch = _sourced(workspace, f"ros2 launch landing_gear_sim rig.launch.py "
+                                 f"controller:=external bag:={bag} params_file:={short_params}")
+    example = ROOT / "examples" / "outside_controller.py"
+    controller = _sourced(workspace, f"python3 {example} --ros-args -r __ns:=/rig")
+    output, _ = launch.communicate(timeout=300)
+    controlled, _ = controller.communicate(timeout=60)
+    assert launch.returncode == 0, output[-3000:]
+    assert controller.returncode == 0 and "run ended after 1500 samples" in controlled, controlled
+    recorded = read_bag(bag)
+    assert len(recorded) == 1500 and recorded.pressure_pa.max() > 20e5
+
+
+@needs_ros2
 def test_ros2_tools_on_a_running_rig_a_second_rig_beside_it_and_ctrl_c(workspace, tmp_path,
                                                                         short_params):
     """`ros2 topic hz/echo`, `ros2 param list/get/set` on each node, a second rig in its own
     namespace on the same domain, then a terminal's Ctrl-C on the first `ros2 launch`."""
-    bag = tmp_path / "bag"
-    # a light constant pressure: a stop of a minute, still running when the tools are done
+    from landing_gear_sim.model.parameters import load_parameters
+
+    bag, long_params = tmp_path / "bag", tmp_path / "long.yaml"
+    # a light constant pressure for up to 4 min: still running when the tools are done (a
+    # one-minute run ended before the last `ros2 param` once the graph ran 1.65x real time)
+    load_parameters(overrides={"rig_test.max_duration_s": 240.0}).to_yaml(long_params)
     launch = _sourced(workspace, "exec ros2 launch landing_gear_sim rig.launch.py "
-                      f"profile:=constant pressure_bar:=3 bag:={bag}", start_new_session=True)
+                      f"profile:=constant pressure_bar:=3 bag:={bag} "
+                      f"params_file:={long_params}", start_new_session=True)
     try:
         next(line for line in iter(launch.stdout.readline, "") if "run starts" in line)
         code, hz = _ros(workspace, "timeout -s INT 12 ros2 topic hz /rig/wheel/joint_states")

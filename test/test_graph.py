@@ -13,16 +13,18 @@ import pytest
 import yaml
 from rosbags.rosbag2 import Reader
 
-from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.errors import GraphError, LandingGearSimError
 from landing_gear_sim.model.blocks import ActuatorBlock, LoadingBlock, PlantBlock
 from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.runspec import RunSpec, build_scenario
 from landing_gear_sim.ros.graph import (
+    EXTERNAL,
     LAUNCH_ARGUMENTS,
     RECORDED_TOPICS,
     TOPIC_CLOCK,
     TOPIC_RUN_END,
     GraphOptions,
+    controlled_run,
     describe,
     options_from_arguments,
 )
@@ -68,9 +70,9 @@ def test_every_subscribed_topic_has_one_publisher_in_the_graph(tmp_path):
     assert [n.name for n in nodes] == ["plant", "actuator", "loading_device", "profile", "recorder"]
 
 
-def test_the_plant_waits_for_every_peer_and_each_node_for_its_readers(tmp_path):
+def test_the_plant_waits_for_every_participant_and_each_node_for_its_readers(tmp_path):
     nodes = {n.name: n for n in describe(GraphOptions(bag=tmp_path / "bag"))}
-    assert nodes["plant"].parameters["peers"] == ["actuator", "loading_device", "profile",
+    assert nodes["plant"].parameters["participants"] == ["actuator", "loading_device", "profile",
                                                   "recorder"]
     expected = dict(item.split("=") for item in nodes["plant"].parameters["expected_subscribers"])
     # wheel: profile + recorder; flywheel: loading device + recorder; latched/clock not awaited
@@ -79,6 +81,17 @@ def test_the_plant_waits_for_every_peer_and_each_node_for_its_readers(tmp_path):
     assert TOPIC_CLOCK not in expected and TOPIC_RUN_END not in expected
     assert nodes["profile"].parameters["expected_subscribers"] == ["/rig/brake/current_ref=2"]
     assert set(nodes["recorder"].subscribes) == set(RECORDED_TOPICS)
+
+
+def test_an_external_controller_graph_has_no_command_node_and_a_start_timeout():
+    nodes = {n.name: n for n in describe(GraphOptions(
+        run=controlled_run(RunSpec(), EXTERNAL), controller=EXTERNAL, start_timeout_s=5.0))}
+    assert list(nodes) == ["plant", "actuator", "loading_device"]  # the user brings one
+    assert nodes["plant"].parameters["participants"] == ["actuator", "loading_device"]
+    assert nodes["plant"].parameters["start_timeout_s"] == 5.0
+    assert nodes["actuator"].parameters["run.profile"] == "external"
+    with pytest.raises(GraphError, match="start timeout"):
+        GraphOptions(start_timeout_s=-1.0)
 
 
 def test_without_a_bag_there_is_no_recorder_and_nobody_waits_for_one():

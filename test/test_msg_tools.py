@@ -12,7 +12,7 @@ from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
 from msg_tools.bag_io import BAG_VERSION, TYPESTORE, write_bag
 from msg_tools.bag_read import read_bag
-from msg_tools.contract import CSV_COLUMNS
+from msg_tools.contract import CSV_COLUMNS, LEGACY_CURRENT_TYPE, TOPIC_CURRENT
 from msg_tools.csv_io import read_csv, write_csv
 from msg_tools.errors import RunFormatError
 from msg_tools.run import SIGNALS
@@ -98,16 +98,24 @@ def test_wall_clock_time_keeps_microseconds_through_bag_and_csv(tmp_path, run):
 
 
 def _renamed(source, target, prefix: str = "", legacy: bool = False) -> None:
-    """Copy a bag with its topics as an older graph (``joint_state``) or another rig
-    (``/rig2/...``) named them."""
+    """Copy a bag with its topics as an older graph (0.1: ``joint_state``, the current a
+    ``std_msgs/Float64`` at its log time) or another rig (``/rig2/...``) named them."""
     def name(topic: str) -> str:
         topic = topic.removesuffix("s") if legacy and topic.endswith("joint_states") else topic
         return prefix + topic.removeprefix("/rig") if prefix else topic
 
+    def kind(connection) -> str:
+        return LEGACY_CURRENT_TYPE if legacy and connection.topic == TOPIC_CURRENT else (
+            connection.msgtype)
+
     with Reader(source) as reader, Writer(target, version=BAG_VERSION) as writer:
-        out = {c.topic: writer.add_connection(name(c.topic), c.msgtype, typestore=TYPESTORE)
+        out = {c.topic: writer.add_connection(name(c.topic), kind(c), typestore=TYPESTORE)
                for c in reader.connections}
         for connection, log_time, raw in reader.messages():
+            if kind(connection) != connection.msgtype:
+                command = TYPESTORE.deserialize_cdr(raw, connection.msgtype)
+                raw = TYPESTORE.serialize_cdr(TYPESTORE.types[LEGACY_CURRENT_TYPE](
+                    data=float(command.effort[0])), LEGACY_CURRENT_TYPE)
             writer.write(out[connection.topic], log_time, raw)
 
 
@@ -118,8 +126,9 @@ def test_bags_with_other_names_for_the_contract_topics_read_the_same(tmp_path, r
     write_bag(run, tmp_path / "bag")
     _renamed(tmp_path / "bag", tmp_path / "other", prefix, legacy)
     with Reader(tmp_path / "other") as reader:
-        topics = {c.topic for c in reader.connections}
+        topics = {c.topic: c.msgtype for c in reader.connections}
     assert ("/rig/wheel/joint_state" in topics) == legacy
+    assert (LEGACY_CURRENT_TYPE in topics.values()) == legacy
     assert (f"{prefix}/brake/pressure" in topics) == bool(prefix)
     back, again = read_bag(tmp_path / "bag"), read_bag(tmp_path / "other")
     for name in ("time_s", *SIGNALS):

@@ -13,69 +13,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from graph_support import FIELDS, SHORT, offline_run, rig_command, run_command, wait_for
 from rosbags.rosbag2 import Reader
 
 from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import load_parameters
-from landing_gear_sim.model.runspec import RunSpec, build_scenario
+from landing_gear_sim.model.runspec import RunSpec
 from landing_gear_sim.ros.graph import load_scenario
 from landing_gear_sim.ros.launcher import ros_environment
 from msg_tools.bag_read import read_bag
 from msg_tools.csv_io import format_csv, write_csv
 
 pytest.importorskip("rclpy")
-
-# braking starts early and the run is short, so a graph run takes seconds
-SHORT = {"rig_test.brake_start_s": 0.3, "rig_test.max_duration_s": 1.5}
-FIELDS = ("current_a", "pressure_pa", "wheel_speed_rad_s", "flywheel_speed_rad_s",
-          "vertical_load_n", "longitudinal_force_n")
-
-
-def _sets(values: dict[str, float]) -> list[str]:
-    return [arg for key, value in values.items() for arg in ("--set", f"{key}={value}")]
-
-
-def _rig(*args: str, overrides: dict[str, float] = SHORT) -> list[str]:
-    return [sys.executable, "-m", "landing_gear_sim", "rig", *args, *_sets(overrides)]
-
-
-def _run(command: list[str], timeout: float = 120) -> subprocess.CompletedProcess:
-    return subprocess.run(command, capture_output=True, text=True, timeout=timeout,
-                          env=ros_environment())
-
-
-@pytest.fixture
-def start():
-    """Start a launcher in the background; whatever a failed test leaves running is stopped."""
-    started: list[subprocess.Popen] = []
-
-    def launch(command: list[str]) -> subprocess.Popen:
-        process = subprocess.Popen(command, env=ros_environment(), stdout=subprocess.PIPE,
-                                   stderr=subprocess.PIPE, text=True)
-        started.append(process)
-        return process
-
-    yield launch
-    for process in started:
-        if process.poll() is None:
-            process.send_signal(signal.SIGINT)  # the launcher stops its nodes
-            try:
-                process.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                process.kill()
-
-
-def _offline(overrides: dict[str, float], profile: str = "osc-low"):
-    params = load_parameters(overrides=overrides)
-    return simulate(params, build_scenario(RunSpec(profile=profile), params)).to_run()
-
-
-def _wait_for(predicate, timeout_s: float = 60.0) -> None:
-    deadline = time.monotonic() + timeout_s
-    while not predicate():
-        assert time.monotonic() < deadline, "timed out"
-        time.sleep(0.05)
-
 
 def _pid_of(module: str, launcher: subprocess.Popen) -> int:
     """The node process ``module`` that this launcher started (other tests run graphs too)."""
@@ -87,13 +36,13 @@ def _pid_of(module: str, launcher: subprocess.Popen) -> int:
 def test_lockstep_graph_equals_offline_and_gives_the_same_bag_every_time(tmp_path):
     bags = [tmp_path / "first" / "bag", tmp_path / "second" / "bag"]
     for bag in bags:
-        done = _run(_rig("--profile", "osc-low", "--bag", str(bag)))
+        done = run_command(rig_command("--profile", "osc-low", "--bag", str(bag)))
         assert done.returncode == 0, done.stderr[-3000:]
     files = [sorted(p.relative_to(bag) for p in bag.iterdir()) for bag in bags]
     assert files[0] == files[1]
     for name in files[0]:
         assert (bags[0] / name).read_bytes() == (bags[1] / name).read_bytes(), name
-    graph, offline = read_bag(bags[0]), _offline(SHORT)
+    graph, offline = read_bag(bags[0]), offline_run(SHORT)
     assert len(graph) == len(offline) == 1500
     for field in FIELDS:  # every recorded topic reads back, equal to round-off
         np.testing.assert_allclose(getattr(graph, field), getattr(offline, field),
@@ -104,12 +53,12 @@ def test_lockstep_graph_equals_offline_and_gives_the_same_bag_every_time(tmp_pat
 def test_sigint_to_the_graph_leaves_a_bag_with_the_run_up_to_the_stop(tmp_path, start):
     bag = tmp_path / "bag"
     long_run = {**SHORT, "rig_test.max_duration_s": 30.0}
-    launcher = start(_rig("--profile", "osc-low", "--bag", str(bag), overrides=long_run))
-    _wait_for(lambda: (bag / "metadata.yaml").exists())
+    launcher = start(rig_command("--profile", "osc-low", "--bag", str(bag), overrides=long_run))
+    wait_for(lambda: (bag / "metadata.yaml").exists())
     launcher.send_signal(signal.SIGINT)
     _, stderr = launcher.communicate(timeout=60)
     assert launcher.returncode == 130, stderr[-2000:]
-    _assert_complete(bag, stderr, _offline(long_run))
+    _assert_complete(bag, stderr, offline_run(long_run))
 
 
 def _assert_complete(bag: Path, stderr: str, offline) -> None:
@@ -132,8 +81,8 @@ def test_a_signal_to_the_whole_process_group_stops_everything_cleanly(tmp_path, 
     crashed while closing and kept ~1 s of a 7 s run."""
     bag = tmp_path / "bag"
     long_run = {**SHORT, "rig_test.max_duration_s": 30.0}
-    launcher = subprocess.Popen(_rig("--profile", "osc-low", "--bag", str(bag),
-                                     overrides=long_run),
+    launcher = subprocess.Popen(rig_command("--profile", "osc-low", "--bag", str(bag),
+                                            overrides=long_run),
                                 env=ros_environment(), start_new_session=True, text=True,
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     try:
@@ -141,7 +90,7 @@ def test_a_signal_to_the_whole_process_group_stops_everything_cleanly(tmp_path, 
         cue = "starting" if moment == "starting" else "run starts"
         seen = next(line for line in lines if cue in line)
         if moment == "running":  # the first segment is closed: hundreds of samples
-            _wait_for(lambda: (bag / "metadata.yaml").exists())
+            wait_for(lambda: (bag / "metadata.yaml").exists())
         os.killpg(launcher.pid, sig)
         _, rest = launcher.communicate(timeout=60)
     finally:
@@ -150,7 +99,7 @@ def test_a_signal_to_the_whole_process_group_stops_everything_cleanly(tmp_path, 
     assert launcher.returncode == 130, (seen + rest)[-3000:]
     assert subprocess.run(["pgrep", "-s", str(launcher.pid)]).returncode == 1  # no orphan
     if moment == "running":
-        _assert_complete(bag, rest, _offline(long_run))
+        _assert_complete(bag, rest, offline_run(long_run))
     else:
         assert "Traceback" not in rest and not bag.exists(), rest[-3000:]
 
@@ -158,24 +107,24 @@ def test_a_signal_to_the_whole_process_group_stops_everything_cleanly(tmp_path, 
 def test_a_killed_recorder_leaves_a_readable_bag_and_the_run_goes_on(tmp_path, start):
     bag = tmp_path / "bag"
     run = {**SHORT, "rig_test.max_duration_s": 6.0}
-    launcher = start(_rig("--profile", "osc-low", "--bag", str(bag), overrides=run))
-    _wait_for(lambda: (bag / "metadata.yaml").exists() and len(list(bag.glob("bag_*"))) >= 2)
+    launcher = start(rig_command("--profile", "osc-low", "--bag", str(bag), overrides=run))
+    wait_for(lambda: (bag / "metadata.yaml").exists() and len(list(bag.glob("bag_*"))) >= 2)
     os.kill(_pid_of("nodes.recorder", launcher), signal.SIGKILL)
     _, stderr = launcher.communicate(timeout=120)
     assert launcher.returncode == 0, stderr[-2000:]
     assert "recorder died" in stderr
     survived = read_bag(bag)  # readable as it is, no repair step
     assert survived.time_s[-1] >= 0.5
-    np.testing.assert_allclose(survived.pressure_pa, _offline(run).pressure_pa[:len(survived)],
+    np.testing.assert_allclose(survived.pressure_pa, offline_run(run).pressure_pa[:len(survived)],
                                rtol=1e-9, atol=1e-6)
 
 
 def test_a_killed_actuator_neither_hangs_nor_crashes_the_plant(tmp_path, start):
     bag = tmp_path / "bag"
     run = {**SHORT, "rig_test.max_duration_s": 4.0}
-    launcher = start(_rig("--profile", "osc-low", "--bag", str(bag), "--timeout", "0.5",
-                          overrides=run))
-    _wait_for(lambda: (bag / "metadata.yaml").exists())
+    launcher = start(rig_command("--profile", "osc-low", "--bag", str(bag), "--timeout", "0.5",
+                                 overrides=run))
+    wait_for(lambda: (bag / "metadata.yaml").exists())
     os.kill(_pid_of("nodes.actuator", launcher), signal.SIGKILL)
     _, stderr = launcher.communicate(timeout=120)
     # a participant missing is a failed run, never a success, though the bag is complete
@@ -186,21 +135,30 @@ def test_a_killed_actuator_neither_hangs_nor_crashes_the_plant(tmp_path, start):
     assert recorded.pressure_pa[-1] == 0.0  # the brake went to the safe pressure
 
 
-def test_realtime_graph_follows_the_wall_clock(tmp_path):
+def test_realtime_graph_follows_the_wall_clock_stamped_in_ros_time(tmp_path):
     bag = tmp_path / "bag"
-    started = time.monotonic()
-    done = _run(_rig("--profile", "osc-low", "--clock", "realtime", "--bag", str(bag)))
+    started, wall_started = time.monotonic(), time.time()
+    done = run_command(rig_command("--profile", "osc-low", "--clock", "realtime",
+                                   "--bag", str(bag)))
     assert done.returncode == 0, done.stderr[-3000:]
     recorded = read_bag(bag)
     assert len(recorded) == 1500
     assert time.monotonic() - started > 1.5
+    # stamps are the ROS (system) time each sample was due, on the exact grid
+    assert wall_started < recorded.time_s[0] < time.time()
+    np.testing.assert_allclose(np.diff(recorded.time_s), 1e-3, atol=1e-6)  # float64 at 1.8e9 s
+    # the loading device answers from the first sample on (its JIT once made it ~0.6 s late,
+    # and the wheel rolled unloaded): the rising load is never 0.1 s behind the offline run
+    # (a few ms when the machine is quiet; tens of ms beside the rest of the suite)
+    rising = offline_run(SHORT).vertical_load_n[:300]
+    assert np.all(recorded.vertical_load_n[100:300] >= 0.95 * rising[:200])
     rtf = float(re.search(r"real-time factor ([0-9.]+)", done.stderr).group(1))
     assert rtf <= 1.05  # paced by the wall clock: never faster (slower only if starved)
     assert "real-time pacing: p99 period jitter" in done.stderr  # how well, said at the end
 
 
 def test_replay_publishes_a_run_that_the_recorder_writes_back(tmp_path, reference):
-    measured = _offline(SHORT)
+    measured = offline_run(SHORT)
     write_csv(measured, tmp_path / "run.csv")
     bag = tmp_path / "bag"
     env = ros_environment()
@@ -208,9 +166,9 @@ def test_replay_publishes_a_run_that_the_recorder_writes_back(tmp_path, referenc
     recorder = subprocess.Popen([*node, "landing_gear_sim.ros.nodes.recorder", "--ros-args", "-p",
                                  f"bag:={bag}"], env=env, stderr=subprocess.PIPE, text=True)
     try:
-        replay = _run([*node, "landing_gear_sim.ros.nodes.replay", "--ros-args", "-p",
-                       f"file:={tmp_path / 'run.csv'}", "-p", "speed:=5.0",
-                       "-p", "wait_for_subscribers:=1"])
+        replay = run_command([*node, "landing_gear_sim.ros.nodes.replay", "--ros-args", "-p",
+                              f"file:={tmp_path / 'run.csv'}", "-p", "speed:=5.0",
+                              "-p", "wait_for_subscribers:=1"])
         assert replay.returncode == 0, replay.stderr[-2000:]
         recorder.wait(timeout=60)
     finally:
@@ -224,7 +182,7 @@ def test_replay_publishes_a_run_that_the_recorder_writes_back(tmp_path, referenc
 
 
 def _bad_files(folder: Path) -> dict[str, tuple[Path, str]]:
-    good = format_csv(_offline({"rig_test.max_duration_s": 0.05}))
+    good = format_csv(offline_run({"rig_test.max_duration_s": 0.05}))
     header, *rows = good.splitlines()
     cases = {
         "missing": ("", "no such file"),
@@ -252,8 +210,8 @@ def _with_field(row: str, index: int, value: str) -> str:
 
 def test_replay_of_a_bad_file_is_one_error_line_and_exit_2(tmp_path):
     for name, (path, fragment) in _bad_files(tmp_path).items():
-        done = _run([sys.executable, "-m", "landing_gear_sim.ros.nodes.replay", "--ros-args", "-p",
-                     f"file:={path}"], timeout=60)
+        done = run_command([sys.executable, "-m", "landing_gear_sim.ros.nodes.replay",
+                            "--ros-args", "-p", f"file:={path}"], timeout=60)
         lines = done.stderr.strip().splitlines()
         assert done.returncode == 2, (name, done.stderr)
         assert len(lines) == 1 and str(path) in lines[0] and fragment in lines[0], (name, lines)
@@ -261,9 +219,10 @@ def test_replay_of_a_bad_file_is_one_error_line_and_exit_2(tmp_path):
 
 def test_rig_replay_reruns_a_logged_test_in_the_graph_as_offline(tmp_path):
     """The measured current of a rig log drives the graph; the bag equals the offline re-run."""
-    measured = _offline(SHORT)
+    measured = offline_run(SHORT)
     write_csv(measured, tmp_path / "rig_log.csv")
-    done = _run(_rig("--replay", str(tmp_path / "rig_log.csv"), "--bag", str(tmp_path / "bag")))
+    done = run_command(rig_command("--replay", str(tmp_path / "rig_log.csv"),
+                                   "--bag", str(tmp_path / "bag")))
     assert done.returncode == 0, done.stderr[-3000:]
     params = load_parameters(overrides=SHORT)
     rerun = simulate(params, load_scenario(RunSpec(profile="file",
@@ -282,7 +241,7 @@ def test_rig_replay_reruns_a_logged_test_in_the_graph_as_offline(tmp_path):
 def test_controller_node_in_lockstep_equals_the_offline_closed_loop(tmp_path, kind):
     from antiskid.closed_loop import closed_loop, make_controller
 
-    done = _run(_rig("--controller", kind, "--bag", str(tmp_path / "bag")))
+    done = run_command(rig_command("--controller", kind, "--bag", str(tmp_path / "bag")))
     assert done.returncode == 0, done.stderr[-3000:]
     rig = load_parameters(overrides=SHORT)
     offline = closed_loop(rig, make_controller(kind, rig, 1e-3)).to_run()
@@ -356,16 +315,17 @@ def test_a_running_node_answers_ros2_param_and_refuses_changes_with_the_reason(s
 
 
 def test_a_misspelt_parameter_stops_the_node_with_the_closest_name(tmp_path):
-    plant = _run([sys.executable, "-m", "landing_gear_sim.ros.nodes.plant", "--ros-args",
-                  "-p", "run.profil:=steps"])
+    plant = run_command([sys.executable, "-m", "landing_gear_sim.ros.nodes.plant",
+                         "--ros-args", "-p", "run.profil:=steps"])
     assert plant.returncode == 2
     assert plant.stderr.strip().splitlines()[-1] == (
         "plant: error: unknown parameter 'run.profil' (did you mean 'run.profile'?)")
     params = tmp_path / "params.yaml"  # the rig's keys for every node are no typo
     params.write_text("/**:\n  ros__parameters:\n    friction.theta1: 1.0\n"
                       "    run.profile: steps\n    segmentt_s: 1.0\n")
-    recorder = _run([sys.executable, "-m", "landing_gear_sim.ros.nodes.recorder", "--ros-args",
-                     "--params-file", str(params), "-p", f"bag:={tmp_path / 'bag'}"])
+    recorder = run_command([sys.executable, "-m", "landing_gear_sim.ros.nodes.recorder",
+                            "--ros-args", "--params-file", str(params),
+                            "-p", f"bag:={tmp_path / 'bag'}"])
     assert recorder.returncode == 2
     assert recorder.stderr.strip().splitlines()[-1] == (
         "recorder: error: unknown parameter 'segmentt_s' (did you mean 'segment_s'?)")
@@ -375,12 +335,12 @@ def test_a_misspelt_parameter_stops_the_node_with_the_closest_name(tmp_path):
 def test_two_rigs_share_a_domain_each_in_its_namespace(tmp_path, start):
     """`--namespace` moves every node and topic (start/stop handshake included): two rigs
     on one domain run the same profile at once and each records exactly its own run."""
-    rigs = {name: start(_rig("--profile", "osc-low", "--namespace", name, "--bag",
-                             str(tmp_path / name))) for name in ("rig_a", "lab/rig_b")}
+    rigs = {name: start(rig_command("--profile", "osc-low", "--namespace", name, "--bag",
+                                    str(tmp_path / name))) for name in ("rig_a", "lab/rig_b")}
     for process in rigs.values():
         _, errors = process.communicate(timeout=180)
         assert process.returncode == 0, errors[-3000:]
-    offline = _offline(SHORT)
+    offline = offline_run(SHORT)
     for name in rigs:
         bag = tmp_path / name
         with Reader(bag) as reader:

@@ -47,8 +47,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_run_arguments(rig)
     rig.add_argument("--replay", type=Path, metavar="RUN",
                      help="re-run a recorded rig test: its current drives the simulated graph")
-    rig.add_argument("--controller", choices=["threshold", "slip"],
-                     help="anti-skid controller in closed loop instead of a profile")
+    rig.add_argument("--controller", choices=["threshold", "slip", "external"],
+                     help="anti-skid controller in closed loop instead of a profile; "
+                     "external: your own node publishes the brake commands (see "
+                     "examples/outside_controller.py; the run waits for it)")
     rig.add_argument("--clock", choices=["lockstep", "realtime"], default="lockstep",
                      help="lockstep: sim time, deterministic (default); realtime: wall clock")
     rig.add_argument("--bag", type=Path, help="bag folder (default out/rig/<run>_<time>)")
@@ -57,6 +59,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     rig.add_argument("--noise", action="store_true", help="add the sensors.* noise")
     rig.add_argument("--timeout", type=float, default=10.0,
                      help="lockstep: seconds to wait for a silent node before holding its input")
+    rig.add_argument("--start-timeout", type=float, default=60.0,
+                     help="seconds to wait for every participant (an external controller) "
+                     "before giving up with an error; 0: wait forever")
     rig.add_argument("--safe-pressure-bar", type=float, default=0.0,
                      help="brake pressure applied once the actuator is lost (default 0)")
     rig.add_argument("--namespace", default="rig",
@@ -146,6 +151,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 def cmd_rig(args: argparse.Namespace) -> int:
     from landing_gear_sim.ros.graph import (
         LOST_PEER_EXIT,
+        NOT_STARTED_EXIT,
         GraphOptions,
         controlled_run,
         load_scenario,
@@ -165,6 +171,7 @@ def cmd_rig(args: argparse.Namespace) -> int:
         raise LandingGearSimError(f"{bag}: exists already; remove it or choose another --bag")
     options = GraphOptions(run=spec, clock=args.clock, bag=bag, storage=args.storage,
                            sensor_noise=args.noise, timeout_s=args.timeout,
+                           start_timeout_s=args.start_timeout,
                            safe_pressure_pa=args.safe_pressure_bar * PA_PER_BAR,
                            replay=args.replay is not None, controller=args.controller,
                            parameter_services=args.parameter_services,
@@ -186,7 +193,8 @@ def cmd_rig(args: argparse.Namespace) -> int:
         return 130
     if not outcome.ok:
         code = outcome.exit_codes.get("plant")
-        why = "; a lost node's input was held, see above" if code == LOST_PEER_EXIT else ""
+        why = {LOST_PEER_EXIT: "; a lost node's input was held, see above",
+               NOT_STARTED_EXIT: "; the run could not start, see above"}.get(code or 0, "")
         print(f"{PROG}: error: the run failed (plant exit code {code}{why})", file=sys.stderr)
         return 1
     return 0
@@ -200,8 +208,8 @@ def _bag_summary(bag: Path) -> str:
         run = read_bag(bag)
     except RunFormatError as exc:
         return f"bag: {bag} (not readable as a run: {exc})"
-    return (f"bag: {bag} ({len(run)} samples, {run.time_s[-1]:.3f} s, max pressure "
-            f"{run.pressure_pa.max() / PA_PER_BAR:.2f} bar, flywheel "
+    return (f"bag: {bag} ({len(run)} samples, {run.time_s[-1] - run.time_s[0]:.3f} s, max "
+            f"pressure {run.pressure_pa.max() / PA_PER_BAR:.2f} bar, flywheel "
             f"{run.flywheel_speed_rad_s[0]:.1f} -> {run.flywheel_speed_rad_s[-1]:.1f} rad/s)")
 
 

@@ -46,9 +46,13 @@ RECORDED_TOPICS = (TOPIC_CURRENT, *SENSOR_TOPICS)
 CONTROLLER_NODE = "antiskid_controller"
 LOST_PEER_EXIT = 3
 """Exit code of a plant whose run lost a participant (held its input): never a success."""
+NOT_STARTED_EXIT = 4
+"""Exit code of a plant whose run could not start (a participant missing)."""
 NAMESPACE_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*")
 """A ROS namespace without its leading '/' (what ``-r __ns:=/...`` and launch accept)."""
 CLOCKS = ("lockstep", "realtime")
+EXTERNAL = "external"
+"""The controller of a graph whose brake commands come from the user's own node."""
 STORAGES = ("mcap", "sqlite3")
 
 ParamValue = bool | int | float | str | list[str]
@@ -84,8 +88,12 @@ class GraphOptions:
         storage: ``mcap`` or ``sqlite3``.
         sensor_noise: add the ``sensors.*`` noise to the published sensor values.
         timeout_s: lockstep: how long the plant waits for a peer before holding its input.
+        start_timeout_s: how long the plant waits for the run to be able to start (every
+            participant linked) before giving up with an error; 0: forever.
         safe_pressure_pa: brake pressure the plant applies when the actuator is lost.
-        controller: anti-skid controller node to run instead of the profile node.
+        controller: anti-skid controller node to run instead of the profile node, or
+            ``external``: none, the commands come from a node started by the user (the
+            plant waits for it, see nodes/plant.py).
         replay: the run's current comes from the ``replay`` node (``run.file``), not
             the profile node.
         parameter_services: the nodes answer ``ros2 param`` (off: the bench's comparison).
@@ -101,6 +109,7 @@ class GraphOptions:
     storage: str = "mcap"
     sensor_noise: bool = False
     timeout_s: float = 10.0  # long: a starved (not dead) node must not be declared lost
+    start_timeout_s: float = 60.0
     safe_pressure_pa: float = 0.0
     controller: str | None = None
     replay: bool = False
@@ -117,6 +126,8 @@ class GraphOptions:
             raise GraphError(f"storage must be one of {', '.join(STORAGES)}")
         if not (math.isfinite(self.timeout_s) and self.timeout_s > 0):
             raise GraphError("the lockstep timeout must be > 0 s")
+        if not (math.isfinite(self.start_timeout_s) and self.start_timeout_s >= 0):
+            raise GraphError("the start timeout must be >= 0 s (0: wait forever)")
         if self.replay and self.run.profile != "file":
             raise GraphError("a replay graph needs the run file (profile 'file')")
 
@@ -129,7 +140,8 @@ LAUNCH_ARGUMENTS: dict[str, tuple[str, str]] = {
     "params_file": ("", "ROS 2 params file of the rig (default: bundled reference rig)"),
     "bag": ("", "rosbag2 folder to record into (empty: no recorder)"),
     "storage": ("mcap", "mcap | sqlite3"),
-    "controller": ("", "anti-skid controller type instead of the profile (threshold | slip)"),
+    "controller": ("", "anti-skid controller instead of the profile: threshold | slip | "
+                   "external (your own node publishes the commands)"),
     "namespace": (NAMESPACE, "namespace of the rig's nodes and topics (a second rig: rig2)"),
 }
 """Launch-file arguments: name -> (default, description)."""
@@ -190,12 +202,15 @@ def describe(options: GraphOptions) -> list[NodeSpec]:
     nodes = [
         NodeSpec("plant", {**run, **shared, "sensor_noise": options.sensor_noise,
                            "timeout_s": options.timeout_s,
+                           "start_timeout_s": options.start_timeout_s,
                            "safe_pressure_pa": options.safe_pressure_pa},
                  (*SENSOR_TOPICS, TOPIC_CLOCK, TOPIC_RUN_END), (TOPIC_HYDRAULIC, TOPIC_LOAD)),
         NodeSpec("actuator", {**run, **shared}, (TOPIC_HYDRAULIC,), (TOPIC_CURRENT,)),
         NodeSpec("loading_device", {**run, **shared}, (TOPIC_LOAD,), (TOPIC_FLYWHEEL,)),
     ]
-    if options.controller:
+    if options.controller == EXTERNAL:
+        pass  # the user's node: the plant finds it in the graph
+    elif options.controller:
         nodes.append(NodeSpec(CONTROLLER_NODE, {**run, **shared, "type": options.controller},
                               (TOPIC_CURRENT,), (TOPIC_WHEEL, TOPIC_FLYWHEEL)))
     elif options.replay:
@@ -225,7 +240,7 @@ def _with_links(nodes: list[NodeSpec]) -> list[NodeSpec]:
         # node's default, which expects no reader, instead
         extra: dict[str, ParamValue] = {"expected_subscribers": expected} if expected else {}
         if node.name == "plant":
-            extra["peers"] = [n.name for n in nodes if n.name != "plant"]
+            extra["participants"] = [n.name for n in nodes if n.name != "plant"]
         linked.append(NodeSpec(node.name, {**node.parameters, **extra}, node.publishes,
                                node.subscribes))
     return linked

@@ -24,9 +24,10 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from rclpy.signals import SignalHandlerGuardCondition
 from rclpy.subscription import Subscription
 from sensor_msgs.msg import FluidPressure, JointState
-from std_msgs.msg import Float64, String, UInt64
+from std_msgs.msg import String, UInt64
 
 from landing_gear_sim.errors import GraphError, LandingGearSimError
+from landing_gear_sim.model.blocks import step_time
 from landing_gear_sim.ros.graph import TOPIC_READY, TOPIC_RUN_END
 from landing_gear_sim.ros.nodes import stop_requested
 from landing_gear_sim.ros.nodes.parameters import check_overrides, declare, refuse_changes
@@ -37,6 +38,7 @@ from msg_tools.contract import (
     TOPIC_PRESSURE,
     TOPIC_WHEEL,
     TOPIC_WRENCH,
+    VALVE_JOINT,
 )
 
 RCLError = _rclpy.RCLError  # what rcl raises once its context is shut down
@@ -51,19 +53,62 @@ LATCHED_QOS = QoSProfile(reliability=ReliabilityPolicy.RELIABLE,
 
 HANDSHAKE_PERIOD_S = 0.02
 
-CONTRACT_KINDS = {TOPIC_CURRENT: Float64, TOPIC_PRESSURE: FluidPressure, TOPIC_WHEEL: JointState,
+CONTRACT_KINDS = {TOPIC_CURRENT: JointState, TOPIC_PRESSURE: FluidPressure, TOPIC_WHEEL: JointState,
                   TOPIC_FLYWHEEL: JointState, TOPIC_WRENCH: WrenchStamped}
 """rclpy message class of each contract topic (msg_tools.contract.TOPIC_TYPES)."""
 
 
 def to_stamp(time_s: float) -> Time:
-    nanoseconds = round(time_s * 1e9)
+    return stamp_of_ns(round(time_s * 1e9))
+
+
+def stamp_of_ns(nanoseconds: int) -> Time:
     return Time(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
 
 
-def step_of(stamp: Time, rate_hz: float) -> int:
-    """The exchange step a stamp belongs to (stamps are k/rate rounded to 1 ns)."""
-    return round((stamp.sec + stamp.nanosec * 1e-9) * rate_hz)
+def ns_of(stamp: Time) -> int:
+    return stamp.sec * 1_000_000_000 + stamp.nanosec
+
+
+class RunClock:
+    """Sample k of a run ↔ its stamp: origin + k·h, to the nanosecond.
+
+    Lockstep runs on sim time from 0 (``origin_ns=0``). In real time the plant stamps
+    sample 0 with the ROS clock when the run starts, and every other node takes that stamp
+    as the origin from the first sample it receives (:meth:`observe`), so stamps are ROS
+    time (``ros2 topic delay`` works) and indices stay exact.
+    """
+
+    def __init__(self, step_s: float, origin_ns: int | None = 0) -> None:
+        self.step_s = step_s
+        self.origin_ns = origin_ns
+
+    def observe(self, stamp: Time) -> None:
+        """Take ``stamp`` as the origin if none is known yet (the run's first sample)."""
+        if self.origin_ns is None:
+            self.origin_ns = ns_of(stamp)
+
+    def step_of(self, stamp: Time) -> int:
+        """The step a stamp belongs to (stamps are origin + k·h rounded to 1 ns)."""
+        return round((ns_of(stamp) - (self.origin_ns or 0)) * 1e-9 / self.step_s)
+
+    def stamp(self, step: int) -> Time:
+        return stamp_of_ns((self.origin_ns or 0) + round(step_time(step, self.step_s) * 1e9))
+
+
+def command_message() -> JointState:
+    """A brake command to fill: ``effort[0]`` is the valve current [A]; the stamp ends the
+    interval it holds for (:data:`msg_tools.contract.TOPIC_CURRENT`)."""
+    message = JointState(name=[VALVE_JOINT], effort=[0.0])
+    message.header.frame_id = VALVE_JOINT
+    return message
+
+
+def command_current(message: JointState) -> float | None:
+    """The valve current [A] a command carries, or None when it names no valve effort."""
+    names = list(message.name)
+    index = names.index(VALVE_JOINT) if VALVE_JOINT in names else 0 if not names else -1
+    return float(message.effort[index]) if 0 <= index < len(message.effort) else None
 
 
 class Handshake:
@@ -126,6 +171,29 @@ def announce_ready(node: GraphNode) -> Callable[[], None]:
         node.get_logger().info("linked; waiting for the plant")
 
     return ready
+
+
+def outside_gaps(node: Node, publishers: dict[str, Publisher]) -> list[str]:
+    """What the graph shows that is not linked yet, in words: readers of ``publishers``
+    not matched, no node publishing brake commands, or a command publisher (an outside
+    controller the plant was not told about) that does not read the plant's samples yet."""
+    gaps = [f"{p.topic_name}: {p.get_subscription_count()} of {shown} readers matched"
+            for p in publishers.values()
+            if (shown := node.count_subscribers(p.topic_name)) > p.get_subscription_count()]
+    commands = node.resolve_topic_name(relative(TOPIC_CURRENT))
+    samples = node.resolve_topic_name(relative(TOPIC_WHEEL))
+    writers = {_full_name(i) for i in node.get_publishers_info_by_topic(commands)}
+    readers = {_full_name(i) for i in node.get_subscriptions_info_by_topic(samples)}
+    if not writers:
+        gaps.append(f"no node publishes brake commands on {commands} (an outside controller "
+                    "not started?)")
+    gaps += [f"{name} publishes {commands} but does not read {samples} yet"
+             for name in sorted(writers - readers)]
+    return gaps
+
+
+def _full_name(endpoint: Any) -> str:
+    return f"{endpoint.node_namespace.rstrip('/')}/{endpoint.node_name}"
 
 
 _NO_PUB_EVENTS = PublisherEventCallbacks(use_default_callbacks=False)

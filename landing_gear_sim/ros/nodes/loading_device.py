@@ -5,15 +5,14 @@ from __future__ import annotations
 from geometry_msgs.msg import Vector3Stamped
 from sensor_msgs.msg import JointState
 
-from landing_gear_sim.model.blocks import LoadingBlock, step_time
+from landing_gear_sim.model.blocks import LoadingBlock
 from landing_gear_sim.ros.graph import TOPIC_LOAD
 from landing_gear_sim.ros.nodes.common import (
     GraphNode,
     Handshake,
+    RunClock,
     announce_ready,
     main_for,
-    step_of,
-    to_stamp,
 )
 from landing_gear_sim.ros.nodes.parameters import rig_and_run
 from msg_tools.contract import TOPIC_FLYWHEEL
@@ -22,8 +21,9 @@ from msg_tools.contract import TOPIC_FLYWHEEL
 class LoadingDeviceNode(GraphNode):
     def __init__(self) -> None:
         super().__init__("loading_device")
-        params, scenario, _ = rig_and_run(self)
-        self._rate_hz, self._step_s = scenario.rate_hz, scenario.step_s
+        params, scenario, lockstep = rig_and_run(self)
+        self._run_clock = RunClock(scenario.step_s, 0 if lockstep else None)
+        LoadingBlock(params, scenario.step_s, True).step(0, 0.0)  # JIT now: see PlantNode
         self._block = LoadingBlock(params, scenario.step_s, scenario.contact)
         self._message = Vector3Stamped()
         self._message.header.frame_id = "gear"
@@ -32,9 +32,10 @@ class LoadingDeviceNode(GraphNode):
         Handshake(self, {TOPIC_LOAD: self._out}, [speed], announce_ready(self))
 
     def _on_speed(self, message: JointState) -> None:
-        step = step_of(message.header.stamp, self._rate_hz)
+        self._run_clock.observe(message.header.stamp)
+        step = self._run_clock.step_of(message.header.stamp)
         self._message.vector.z = self._block.step(step, message.velocity[0])
-        self._message.header.stamp = to_stamp(step_time(step + 1, self._step_s))
+        self._message.header.stamp = self._run_clock.stamp(step + 1)
         self._out.publish(self._message)
 
 

@@ -5,7 +5,14 @@ Lockstep (default): the plant publishes sample k (sensor topics stamped k·h, an
 device's force stamped (k+1)·h have arrived. A peer silent for ``timeout_s`` is
 logged as lost; from then on its input is held (the brake pressure goes to
 ``safe_pressure_pa``) and the run goes on, so the recorder is still fed.
-Real time: a wall-clock timer advances one step per period with the latest inputs.
+Real time: a wall-clock timer advances one step per period with the latest inputs; the
+samples are stamped with the ROS time they are due (the run's start + k·h).
+
+The run starts when every link is matched, every node of ``participants`` has said it
+is linked, and every node the graph shows publishing brake commands (an outside
+controller) reads the plant's samples through a matched link: a controller that joined
+late would miss sample 0 and never answer. A run that cannot start in
+``start_timeout_s`` is an error (exit 4), never a run without braking.
 """
 
 from __future__ import annotations
@@ -14,6 +21,7 @@ import os
 import time
 
 import numpy as np
+from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Vector3Stamped, WrenchStamped
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import FluidPressure, JointState
@@ -22,6 +30,7 @@ from std_msgs.msg import String, UInt64
 from landing_gear_sim.model.blocks import PlantBlock, SensorSample
 from landing_gear_sim.ros.graph import (
     LOST_PEER_EXIT,
+    NOT_STARTED_EXIT,
     TOPIC_CLOCK,
     TOPIC_HYDRAULIC,
     TOPIC_LOAD,
@@ -33,9 +42,10 @@ from landing_gear_sim.ros.nodes.common import (
     LATCHED_QOS,
     GraphNode,
     Handshake,
+    RunClock,
+    RunFinishedError,
     main_for,
-    step_of,
-    to_stamp,
+    outside_gaps,
 )
 from landing_gear_sim.ros.nodes.parameters import declare, rig_and_run
 from msg_tools.contract import (
@@ -61,13 +71,22 @@ class PlantNode(GraphNode):
                                         "lockstep: wait this long for a peer, then hold its input"))
         self._safe_pa = float(declare(self, "safe_pressure_pa", 0.0,
                                       "brake pressure applied once the actuator is lost [Pa]"))
-        self._peers = {str(p) for p in declare(self, "peers", [""], "nodes to wait for") if p}
+        self._participants = {str(p) for p in declare(
+            self, "participants", [""], "nodes whose 'linked' message the run waits for; "
+            "any other node that publishes commands is waited for through the graph") if p}
+        self._start_timeout_s = float(declare(
+            self, "start_timeout_s", 60.0, "give up (exit 4) when the run could not start "
+            "in this long [s]; 0: wait forever"))
         self._priority = int(declare(self, "realtime_priority", 10,
                                      "real time: SCHED_FIFO priority of the stepping thread "
                                      "(1-99; 0: leave the scheduling alone)"))
+        # compile the step functions before the run: in real time the first samples do not
+        # wait (the loading device's first force came ~0.6 s late, the wheel rolled unloaded)
+        PlantBlock(params, self._scenario).advance(0.0, 0.0)
         self._plant = PlantBlock(params, self._scenario,
                                  np.random.default_rng(seed) if noise else None)
         self._rate_hz = self._scenario.rate_hz
+        self._run_clock = RunClock(self._scenario.step_s, 0 if self._lockstep else None)
         self._pending: dict[str, dict[int, float]] = {ACTUATOR: {}, LOADING: {}}
         self._latest = {ACTUATOR: 0.0, LOADING: 0.0}
         self._lost: set[str] = set()
@@ -83,7 +102,7 @@ class PlantNode(GraphNode):
                   self.subscription(Vector3Stamped, TOPIC_LOAD, self._on_load)]
         self.subscription(String, TOPIC_READY, self._on_ready, LATCHED_QOS)
         self._handshake = Handshake(self, self._out, inputs, self._on_linked)
-        self._last_progress = time.monotonic()
+        self._created = self._last_progress = time.monotonic()
         self._wall_start = 0.0
         self._published_at: list[float] = []  # real time: wall time of each step's sample
         self._lateness: list[float] = []  # real time: wake-up after the tick's time [s]
@@ -92,7 +111,7 @@ class PlantNode(GraphNode):
         mode = "lockstep" if self._lockstep else "real time"
         self.get_logger().info(f"{self._scenario.name}: up to {self._plant.n_steps} steps at "
                                f"{self._rate_hz:g} Hz, {mode}; waiting for "
-                               f"{', '.join(sorted(self._peers)) or 'inputs'}")
+                               f"{', '.join(sorted(self._participants)) or 'inputs'}")
 
     # --- start --------------------------------------------------------------------------
     def _on_ready(self, message: String) -> None:
@@ -104,10 +123,13 @@ class PlantNode(GraphNode):
         self._maybe_start()
 
     def _maybe_start(self) -> None:
-        if self._started or not self._linked or not self._peers <= self._ready:
+        if (self._started or not self._linked or not self._participants <= self._ready
+                or outside_gaps(self, self._out)):
             return
         self._started = True
         self._wall_start = self._last_progress = time.monotonic()
+        if not self._lockstep:  # stamps are ROS time from here on
+            self._run_clock.origin_ns = self.get_clock().now().nanoseconds
         self.get_logger().info("all links matched: run starts")
         self._publish(self._plant.sample())
         if not self._lockstep:
@@ -138,10 +160,9 @@ class PlantNode(GraphNode):
     def _on_load(self, message: Vector3Stamped) -> None:
         self._take(LOADING, message.header.stamp, message.vector.z)
 
-    def _take(self, peer: str, stamp: object, value: float) -> None:
-        self._latest[peer] = value
+    def _take(self, peer: str, stamp: Time, value: float) -> None:
+        self._pending[peer][self._run_clock.step_of(stamp)] = value
         if self._lockstep:
-            self._pending[peer][step_of(stamp, self._rate_hz)] = value
             self._advance_lockstep()
 
     # --- stepping -----------------------------------------------------------------------
@@ -163,9 +184,21 @@ class PlantNode(GraphNode):
         self._lateness.append(woke - self._wall_start
                               - (self._plant.step_index + 1.5) / self._rate_hz)
         while not self._done and self._plant.step_index < due:
-            self._step(self._latest[ACTUATOR], self._latest[LOADING])
+            target = self._plant.step_index + 1
+            self._step(self._in_force(ACTUATOR, target), self._in_force(LOADING, target))
             self._published_at.append(time.monotonic())
         self._busy.append(time.monotonic() - woke)
+
+    def _in_force(self, peer: str, step: int) -> float:
+        """Real time: the input stamped for ``step``, or the newest one due by then (late),
+        or the one held; inputs stamped ahead wait for their step."""
+        pending = self._pending[peer]
+        due = [s for s in pending if s <= step]
+        if due:
+            self._latest[peer] = pending[max(due)]
+            for s in due:
+                del pending[s]
+        return self._latest[peer]
 
     def _step(self, pressure_pa: float, load_n: float) -> None:
         self._plant.advance(pressure_pa, load_n)
@@ -173,7 +206,8 @@ class PlantNode(GraphNode):
         self._publish(self._plant.sample())
 
     def _publish(self, sample: SensorSample) -> None:
-        for topic, message in self._messages.fill(sample).items():
+        stamp = self._run_clock.stamp(sample.step)
+        for topic, message in self._messages.fill(sample, stamp).items():
             self._out[topic].publish(message)
         if self._plant.finished():
             self._finish()
@@ -206,7 +240,9 @@ class PlantNode(GraphNode):
     # --- faults -------------------------------------------------------------------------
     def _watchdog(self) -> None:
         if not self._started:
-            self._report_waiting()
+            self._maybe_start()  # the graph's other nodes show up without a message to us
+            if not self._started:
+                self._report_waiting()
             return
         silent_s = time.monotonic() - self._last_progress
         if self._done or not self._lockstep or silent_s < self._timeout_s:
@@ -225,11 +261,20 @@ class PlantNode(GraphNode):
         self._last_progress = time.monotonic() - self._timeout_s  # lost: no more waiting
 
     def _report_waiting(self) -> None:
+        waited_s = time.monotonic() - self._created
+        if 0 < self._start_timeout_s < waited_s:
+            self.get_logger().error(f"the run could not start in {self._start_timeout_s:g} s: "
+                                    f"{self._missing()}")
+            self.exit_code = NOT_STARTED_EXIT
+            self._end.publish(UInt64(data=0))  # the others leave too
+            raise RunFinishedError(self.get_name())
         if time.monotonic() - self._last_progress > 5.0:
             self._last_progress = time.monotonic()
-            missing = self._handshake.missing() + [
-                f"{peer} not linked" for peer in sorted(self._peers - self._ready)]
-            self.get_logger().warning("still waiting: " + "; ".join(missing))
+            self.get_logger().warning(f"still waiting ({waited_s:.0f} s): {self._missing()}")
+
+    def _missing(self) -> str:
+        return "; ".join(self._handshake.missing() + outside_gaps(self, self._out) + [
+            f"{name} not linked" for name in sorted(self._participants - self._ready)])
 
     def close(self) -> None:
         if not self.context.ok():  # stopped by a signal: the context is gone, nothing to flush
@@ -252,8 +297,7 @@ class _Messages:
         self.wrench = WrenchStamped()
         self.wrench.header.frame_id = "load_cell"
 
-    def fill(self, sample: SensorSample) -> dict[str, object]:
-        stamp = to_stamp(sample.time_s)
+    def fill(self, sample: SensorSample, stamp: Time) -> dict[str, object]:
         self.clock.clock = stamp
         for message in (self.wheel, self.flywheel, self.pressure, self.wrench):
             message.header.stamp = stamp

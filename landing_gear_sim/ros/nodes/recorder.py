@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import struct
 import time
+from collections import deque
 from pathlib import Path
 
 from landing_gear_sim.errors import GraphError
@@ -71,7 +72,8 @@ class RecorderNode(GraphNode):
             storage, join)
         self._samples: dict[int, dict[str, bytes]] = {}
         self._order: list[int] = []  # sample stamps in order (the wheel topic's arrival order)
-        self._currents: list[bytes] = []
+        self._currents: deque[tuple[int, bytes]] = deque()  # commands not written yet
+        self._latest_command_ns = -1
         self._written = 0
         self._segment_start: int | None = None
         self._end_seen_at: float | None = None
@@ -95,12 +97,16 @@ class RecorderNode(GraphNode):
         return on_sample
 
     def _on_current(self, raw: bytes) -> None:
-        self._currents.append(raw)
+        stamp = stamp_ns(raw)
+        self._currents.append((stamp, raw))
+        self._latest_command_ns = max(self._latest_command_ns, stamp)
         self._flush()
 
     def _complete(self, index: int) -> bool:
-        messages = self._samples.get(self._order[index], {})
-        return len(messages) == len(SENSOR_TOPICS) and (index == 0 or len(self._currents) >= index)
+        """A sample's sensors are in, and the command that holds up to it (none for the first)."""
+        stamp = self._order[index]
+        return len(self._samples.get(stamp, {})) == len(SENSOR_TOPICS) and (
+            index == 0 or self._latest_command_ns >= stamp)
 
     def _flush(self, force: bool = False) -> None:
         """Write every sample that is complete (or, forced or lagging, whatever it has)."""
@@ -120,8 +126,9 @@ class RecorderNode(GraphNode):
             self._writer.roll()
             self._segment_start, self._in_segment = stamp, 0
         self._in_segment += 1
-        if 0 < index <= len(self._currents):
-            self._writer.write(self._names[TOPIC_CURRENT], stamp, self._currents[index - 1])
+        while self._currents and self._currents[0][0] <= stamp:
+            command_ns, raw = self._currents.popleft()
+            self._writer.write(self._names[TOPIC_CURRENT], command_ns, raw)
         messages = self._samples.pop(stamp, {})
         for topic in SENSOR_TOPICS:
             if topic in messages:

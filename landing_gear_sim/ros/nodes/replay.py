@@ -60,7 +60,7 @@ class ReplayNode(GraphNode):
             params = rig_parameters(self)
             spec = replace(run_spec(self), profile="file", file=path)
             scenario = build_scenario(spec, params, self._run)
-            self._feed = CurrentFeed(self, scenario.current_a, scenario.rate_hz, ahead)
+            self._feed = CurrentFeed(self, scenario.current_a, scenario.step_s, ahead)
             return
         self._out = {topic: self.publisher(kind, topic, DATA_QOS)
                      for topic, kind in CONTRACT_KINDS.items()}
@@ -91,9 +91,11 @@ class ReplayNode(GraphNode):
     def _publish(self, k: int) -> None:
         self._clock_out.publish(Clock(clock=to_stamp(float(self._run.time_s[k]))))
         messages = contract_messages(self._run, k)
-        # at t_k a controller sends the command for [t_k, t_k+1), which the log shows at t_k+1
-        held = self._run.current_a[min(k + 1, len(self._run) - 1)]
-        messages[TOPIC_CURRENT] = TYPESTORE.types[TOPIC_TYPES[TOPIC_CURRENT]](data=float(held))
+        # at t_k a controller sends the command for (t_k, t_k+1], stamped t_k+1 as logged
+        if k + 1 < len(self._run):
+            messages[TOPIC_CURRENT] = contract_messages(self._run, k + 1)[TOPIC_CURRENT]
+        else:
+            del messages[TOPIC_CURRENT]
         for topic, message in messages.items():
             # serialised by rosbags: published as is, no conversion to rclpy classes
             self._out[topic].publish(bytes(TYPESTORE.serialize_cdr(message, TOPIC_TYPES[topic])))

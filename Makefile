@@ -54,6 +54,8 @@ bench: $(STAMP)
 	$(BIN)/python bench/controllers.py
 	$(BIN)/python bench/diagnose.py
 	$(BIN)/python bench/io.py
+	$(BIN)/python bench/montecarlo.py
+	$(BIN)/python bench/history.py
 
 clean:
 	rm -rf $(VENV) out build install log .pytest_cache

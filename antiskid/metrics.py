@@ -95,7 +95,7 @@ def braking_metrics(run: Run, rig: RigParameters) -> BrakingMetrics:
         stopping_distance_m=float(scipy.integrate.trapezoid(speed, t)),
         stopping_time_s=duration,
         mean_deceleration_m_s2=float(speed[0] - speed[-1]) / max(duration, 1e-9),
-        braking_efficiency=float(np.mean(friction)) / peak,
+        braking_efficiency=_efficiency(rig, friction, speed[loaded], peak),
         mean_friction=float(np.mean(friction)),
         peak_friction=peak,
         slip_rms=float(np.sqrt(np.mean(slip[moving] ** 2))) if moving.any() else 0.0,
@@ -106,6 +106,19 @@ def braking_metrics(run: Run, rig: RigParameters) -> BrakingMetrics:
         gear_walk_frequency_hz=gear_walk,
         cycling_near_gear_walk=cycles > 0 and abs(cycles - gear_walk) <= GEAR_WALK_BAND * gear_walk,
     )
+
+
+def _efficiency(rig: RigParameters, friction: np.ndarray, speed_m_s: np.ndarray,
+                peak: float) -> float:
+    """Mean friction used over the friction available; on a runway whose surface changes
+    below ``friction.change_speed_m_s`` (a μ-jump) each sample counts against its own
+    surface's peak."""
+    change = rig.number("friction.change_speed_m_s")
+    if change <= 0.0:
+        return float(np.mean(friction)) / peak
+    after, _ = peak_friction(rig.replace({f"friction.theta{i}": rig.number(
+        f"friction.after_theta{i}") for i in (1, 2, 3)}, "the surface after the change"))
+    return float(np.mean(friction / np.where(speed_m_s < change, after, peak)))
 
 
 def _cycling_frequency(pressure_pa: np.ndarray, duration_s: float) -> float:

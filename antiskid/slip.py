@@ -18,7 +18,10 @@ clamped to the valve's range and frozen while the output saturates (anti-windup)
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
+
+import numpy as np
+from numba import njit
 
 from landing_gear_sim.model.elements import slip_ratio
 
@@ -49,52 +52,63 @@ class SlipParams:
             raise ControllerError("slip: initial_current_a must be within [0, max_current_a]")
 
 
-@dataclass
-class SlipState:
-    """Integrator [A], speed estimate [m/s], rolling radius [m] and its learning, last slip."""
+(P_SETPOINT, P_KP, P_KI, P_MIN_SPEED, P_MAX_CURRENT, P_INITIAL_CURRENT,
+ P_RADIUS_LEARN) = range(7)
+"""Indices of :func:`slip_vector` (the field order of SlipParams)."""
 
-    wheel_radius_m: float
-    flywheel_radius_m: float
-    step_s: float
-    integral_a: float = math.nan
-    speed_m_s: float = math.nan
-    slip: float = 0.0
-    radius_sum_m: float = 0.0
-    radius_count: int = 0
+# The state, one float array so that the step compiles (numba): integrator [A] (nan until
+# braking starts), speed estimate [m/s], rolling radius [m] and its learning sums, last slip
+(S_INTEGRAL, S_SPEED, S_SLIP, S_RADIUS, S_RADIUS_SUM, S_RADIUS_COUNT, S_FLYWHEEL_RADIUS,
+ S_STEP) = range(8)
+N_STATE = 8
 
 
-def slip_state(wheel_radius_m: float, flywheel_radius_m: float, step_s: float) -> SlipState:
-    return SlipState(wheel_radius_m, flywheel_radius_m, step_s)
+def slip_vector(params: SlipParams) -> np.ndarray:
+    """The settings as the compiled step reads them (field order of SlipParams)."""
+    return np.array([getattr(params, f.name) for f in fields(params)], dtype=float)
 
 
-def learn_radius(params: SlipParams, state: SlipState, wheel_speed_rad_s: float,
-                 speed_m_s: float, time_to_brake_s: float) -> None:
+def slip_state(wheel_radius_m: float, flywheel_radius_m: float, step_s: float) -> np.ndarray:
+    """Initial state (N_STATE,): radius not learnt yet, integrator not started."""
+    state = np.zeros(N_STATE)
+    state[S_INTEGRAL] = math.nan
+    state[S_RADIUS], state[S_FLYWHEEL_RADIUS], state[S_STEP] = (
+        wheel_radius_m, flywheel_radius_m, step_s)
+    return state
+
+
+@njit(cache=True)
+def learn_radius(p, s, wheel_speed_rad_s, speed_m_s, time_to_brake_s):
     """Before braking: average r = v/ω over the last ``radius_learn_s`` of free rolling."""
-    if 0.0 < time_to_brake_s <= params.radius_learn_s and wheel_speed_rad_s > 1.0:
-        state.radius_sum_m += speed_m_s / wheel_speed_rad_s
-        state.radius_count += 1
-    elif time_to_brake_s <= 0.0 and state.radius_count:
-        state.wheel_radius_m = state.radius_sum_m / state.radius_count
-        state.radius_count = 0
+    if 0.0 < time_to_brake_s <= p[P_RADIUS_LEARN] and wheel_speed_rad_s > 1.0:
+        s[S_RADIUS_SUM] += speed_m_s / wheel_speed_rad_s
+        s[S_RADIUS_COUNT] += 1.0
+    elif time_to_brake_s <= 0.0 and s[S_RADIUS_COUNT] > 0.0:
+        s[S_RADIUS] = s[S_RADIUS_SUM] / s[S_RADIUS_COUNT]
+        s[S_RADIUS_COUNT] = 0.0
 
 
-def slip_step(params: SlipParams, state: SlipState, time_to_brake_s: float,
-              wheel_speed_rad_s: float, flywheel_speed_rad_s: float) -> float:
-    """One step: speeds at t_k → valve current [A] held over [t_k, t_k+1); 0 before braking."""
-    speed = flywheel_speed_rad_s * state.flywheel_radius_m
-    state.speed_m_s = speed
-    learn_radius(params, state, wheel_speed_rad_s, speed, time_to_brake_s)
+@njit(cache=True)
+def slip_step(p, s, time_to_brake_s, wheel_speed_rad_s, flywheel_speed_rad_s):
+    """One step: speeds at t_k → valve current [A] held over [t_k, t_k+1); 0 before braking.
+
+    ``p``: :func:`slip_vector`; ``s``: :func:`slip_state`, updated in place.
+    """
+    speed = flywheel_speed_rad_s * s[S_FLYWHEEL_RADIUS]
+    s[S_SPEED] = speed
+    learn_radius(p, s, wheel_speed_rad_s, speed, time_to_brake_s)
     if time_to_brake_s > 0.0:
         return 0.0
-    if math.isnan(state.integral_a):
-        state.integral_a = params.initial_current_a
-    if speed < params.min_speed_m_s:  # slip is meaningless near standstill: hold
-        return min(max(state.integral_a, 0.0), params.max_current_a)
-    state.slip = float(slip_ratio(speed, wheel_speed_rad_s, state.wheel_radius_m))
-    error = params.slip_setpoint - state.slip  # > 0: room for more brake
-    kp, ki = params.kp_per_m_s * speed, params.ki_per_m_s * speed
-    candidate = state.integral_a + ki * error * state.step_s
+    if math.isnan(s[S_INTEGRAL]):
+        s[S_INTEGRAL] = p[P_INITIAL_CURRENT]
+    limit = p[P_MAX_CURRENT]
+    if speed < p[P_MIN_SPEED]:  # slip is meaningless near standstill: hold
+        return min(max(s[S_INTEGRAL], 0.0), limit)
+    s[S_SLIP] = slip_ratio(speed, wheel_speed_rad_s, s[S_RADIUS])
+    error = p[P_SETPOINT] - s[S_SLIP]  # > 0: room for more brake
+    kp, ki = p[P_KP] * speed, p[P_KI] * speed
+    candidate = s[S_INTEGRAL] + ki * error * s[S_STEP]
     output = candidate + kp * error
-    if 0.0 <= output <= params.max_current_a or (output > params.max_current_a) != (error > 0):
-        state.integral_a = min(max(candidate, 0.0), params.max_current_a)
-    return min(max(state.integral_a + kp * error, 0.0), params.max_current_a)
+    if 0.0 <= output <= limit or (output > limit) != (error > 0):
+        s[S_INTEGRAL] = min(max(candidate, 0.0), limit)
+    return min(max(s[S_INTEGRAL] + kp * error, 0.0), limit)

@@ -20,12 +20,16 @@ re-apply fraction locks the wheel — tune with the bench, not by hand.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import math
+from dataclasses import dataclass, fields
 
-from .common import Deceleration, check_positive
+import numpy as np
+from numba import njit
+
+from landing_gear_sim.model.elements import GRAVITY_M_S2
+
+from .common import check_positive
 from .errors import ControllerError
-
-APPLY, RELEASE, HOLD = "apply", "release", "hold"
 
 
 @dataclass(frozen=True)
@@ -61,71 +65,101 @@ class ThresholdParams:
                                   f"{self.reapply_fraction}")
 
 
-@dataclass
-class ThresholdState:
-    """Phase, current command [A], the current at the last release start, and the η filter."""
+(P_ETA_RELEASE, P_ETA_HOLD, P_ETA_REAPPLY, P_APPLY_RATE, P_REAPPLY_RATE, P_RELEASE_RATE,
+ P_REAPPLY_FRACTION, P_MAX_CURRENT, P_ETA_FILTER, P_SLIP_RELEASE, P_INITIAL_DECEL,
+ P_FLOOR) = range(12)
+"""Indices of :func:`threshold_vector` (the field order of ThresholdParams)."""
 
-    deceleration: Deceleration
-    phase: str = APPLY
-    current_a: float = 0.0
-    release_from_a: float = field(default=0.0)
-    released: bool = False
-    cycles: int = 0
-    reference_rad_s: float = 0.0
-    decel_rad_s2: float = 0.0
-    synced_at: tuple[float, float] | None = None
-    time_s: float = 0.0
+
+# The controller's state, one float array so that the step compiles (numba) and runs
+# inside the compiled closed loop as well as in the node: indices into it.
+(S_FILTERED, S_ETA, S_PHASE, S_CURRENT, S_RELEASE_FROM, S_RELEASED, S_CYCLES, S_REFERENCE,
+ S_DECEL, S_SYNC_TIME, S_SYNC_SPEED, S_TIME, S_RADIUS, S_STEP, S_TAU) = range(15)
+N_STATE = 15
+APPLY, RELEASE, HOLD = 0.0, 1.0, 2.0
+PHASES = ("apply", "release", "hold")
+
+
+def threshold_vector(params: ThresholdParams) -> np.ndarray:
+    """The settings as the compiled step reads them (field order of ThresholdParams)."""
+    return np.array([getattr(params, f.name) for f in fields(params)], dtype=float)
 
 
 def threshold_state(params: ThresholdParams, wheel_radius_m: float,
-                    step_s: float) -> ThresholdState:
-    return ThresholdState(Deceleration(wheel_radius_m, step_s, params.eta_filter_s),
-                          decel_rad_s2=params.initial_decel_m_s2 / wheel_radius_m)
+                    step_s: float) -> np.ndarray:
+    """Initial state (N_STATE,): applying from 0 A, nothing filtered, nothing synchronised."""
+    state = np.zeros(N_STATE)
+    state[S_FILTERED] = state[S_SYNC_TIME] = math.nan
+    state[S_DECEL] = params.initial_decel_m_s2 / wheel_radius_m
+    state[S_RADIUS], state[S_STEP], state[S_TAU] = wheel_radius_m, step_s, params.eta_filter_s
+    return state
 
 
-def _reference(state: ThresholdState, wheel_speed_rad_s: float) -> float:
+@njit(cache=True)
+def _deceleration(s, wheel_speed_rad_s):
+    """η = −ω̇ r / g through a first-order filter of time constant S_TAU (see common)."""
+    if math.isnan(s[S_FILTERED]):
+        s[S_FILTERED] = wheel_speed_rad_s
+        return s[S_ETA]
+    step_s = s[S_STEP]
+    alpha = step_s / (s[S_TAU] + step_s)
+    previous = s[S_FILTERED]
+    s[S_FILTERED] += alpha * (wheel_speed_rad_s - s[S_FILTERED])
+    s[S_ETA] = -(s[S_FILTERED] - previous) / step_s * s[S_RADIUS] / GRAVITY_M_S2
+    return s[S_ETA]
+
+
+@njit(cache=True)
+def _reference(s, wheel_speed_rad_s):
     """Wheel-speed-only vehicle reference: peak hold falling at the learnt deceleration."""
-    step_s = state.deceleration.step_s
-    state.reference_rad_s = max(wheel_speed_rad_s,
-                                state.reference_rad_s - state.decel_rad_s2 * step_s)
-    return (state.reference_rad_s - wheel_speed_rad_s) / max(state.reference_rad_s, 1e-9)
+    s[S_REFERENCE] = max(wheel_speed_rad_s, s[S_REFERENCE] - s[S_DECEL] * s[S_STEP])
+    return (s[S_REFERENCE] - wheel_speed_rad_s) / max(s[S_REFERENCE], 1e-9)
 
 
-def _resynchronised(state: ThresholdState, wheel_speed_rad_s: float) -> None:
+@njit(cache=True)
+def _resynchronised(s, wheel_speed_rad_s):
     """End of a spin-up: the wheel runs at the vehicle speed; learn the vehicle deceleration."""
-    if state.synced_at is not None:
-        then, speed = state.synced_at
-        if state.time_s - then > 0.02:
-            state.decel_rad_s2 = max((speed - wheel_speed_rad_s) / (state.time_s - then), 0.0)
-    state.synced_at = (state.time_s, wheel_speed_rad_s)
-    state.reference_rad_s = wheel_speed_rad_s
+    if not math.isnan(s[S_SYNC_TIME]):
+        elapsed = s[S_TIME] - s[S_SYNC_TIME]
+        if elapsed > 0.02:
+            s[S_DECEL] = max((s[S_SYNC_SPEED] - wheel_speed_rad_s) / elapsed, 0.0)
+    s[S_SYNC_TIME], s[S_SYNC_SPEED] = s[S_TIME], wheel_speed_rad_s
+    s[S_REFERENCE] = wheel_speed_rad_s
 
 
-def threshold_step(params: ThresholdParams, state: ThresholdState, time_to_brake_s: float,
-                   wheel_speed_rad_s: float) -> float:
-    """One step: wheel speed at t_k → valve current [A] held over [t_k, t_k+1); 0 before braking."""
-    eta = state.deceleration.update(wheel_speed_rad_s)
-    step_s = state.deceleration.step_s
-    state.time_s += step_s
-    slip = _reference(state, wheel_speed_rad_s)
+@njit(cache=True)
+def _next_phase(p, s, eta, slip, wheel_speed_rad_s):
+    phase = s[S_PHASE]
+    deep = p[P_SLIP_RELEASE] > 0 and slip > p[P_SLIP_RELEASE] and eta > p[P_ETA_HOLD]
+    if phase == APPLY and (eta > p[P_ETA_RELEASE] or deep):
+        s[S_PHASE], s[S_RELEASE_FROM] = RELEASE, s[S_CURRENT]
+        s[S_RELEASED], s[S_CYCLES] = 1.0, s[S_CYCLES] + 1.0
+    elif phase == RELEASE and (
+            eta < p[P_ETA_HOLD]
+            or s[S_CURRENT] <= p[P_FLOOR] * s[S_RELEASE_FROM]):
+        s[S_PHASE] = HOLD
+    elif phase == HOLD and eta > p[P_ETA_REAPPLY]:
+        s[S_PHASE] = APPLY
+        _resynchronised(s, wheel_speed_rad_s)
+        s[S_CURRENT] = max(s[S_CURRENT], p[P_REAPPLY_FRACTION] * s[S_RELEASE_FROM])
+
+
+@njit(cache=True)
+def threshold_step(p, s, time_to_brake_s, wheel_speed_rad_s):
+    """One step: wheel speed at t_k → valve current [A] held over [t_k, t_k+1); 0 before braking.
+
+    ``p``: :func:`threshold_vector`; ``s``: :func:`threshold_state`, updated in place.
+    """
+    eta = _deceleration(s, wheel_speed_rad_s)
+    s[S_TIME] += s[S_STEP]
+    slip = _reference(s, wheel_speed_rad_s)
     if time_to_brake_s > 0.0:
         return 0.0
-    deep = params.slip_release > 0 and slip > params.slip_release and eta > params.eta_hold
-    if state.phase == APPLY and (eta > params.eta_release or deep):
-        state.phase, state.release_from_a = RELEASE, state.current_a
-        state.released, state.cycles = True, state.cycles + 1
-    elif state.phase == RELEASE and (
-            eta < params.eta_hold
-            or state.current_a <= params.release_floor_fraction * state.release_from_a):
-        state.phase = HOLD
-    elif state.phase == HOLD and eta > params.eta_reapply:
-        state.phase = APPLY
-        _resynchronised(state, wheel_speed_rad_s)
-        state.current_a = max(state.current_a, params.reapply_fraction * state.release_from_a)
-    if state.phase == APPLY:
-        rate = params.reapply_rate_a_s if state.released else params.apply_rate_a_s
-        state.current_a += rate * step_s
-    elif state.phase == RELEASE:
-        state.current_a -= params.release_rate_a_s * step_s
-    state.current_a = min(max(state.current_a, 0.0), params.max_current_a)
-    return state.current_a
+    _next_phase(p, s, eta, slip, wheel_speed_rad_s)
+    if s[S_PHASE] == APPLY:
+        rate = p[P_REAPPLY_RATE] if s[S_RELEASED] > 0.0 else p[P_APPLY_RATE]
+        s[S_CURRENT] += rate * s[S_STEP]
+    elif s[S_PHASE] == RELEASE:
+        s[S_CURRENT] -= p[P_RELEASE_RATE] * s[S_STEP]
+    s[S_CURRENT] = min(max(s[S_CURRENT], 0.0), p[P_MAX_CURRENT])
+    return s[S_CURRENT]

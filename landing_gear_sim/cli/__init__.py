@@ -4,7 +4,8 @@ Every user error ends as one line ``landing-gear-sim: error: ...`` and exit code
 The commands live in :mod:`~landing_gear_sim.cli.model` (simulate, rig, bode, params,
 campaign, convert) and :mod:`~landing_gear_sim.cli.analysis` (identify, validate,
 compare, diagnose, metrics, antiskid) and :mod:`~landing_gear_sim.cli.fleet`
-(history, on Dask); nothing in the package imports this one.
+(history, on Dask) and :mod:`~landing_gear_sim.cli.montecarlo` (montecarlo, on Dask);
+nothing in the package imports this one.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import threading
 from collections.abc import Callable, Sequence
 
 from landing_gear_sim import __version__
-from landing_gear_sim.cli import analysis, fleet, model
+from landing_gear_sim.cli import analysis, fleet, model, montecarlo
 from landing_gear_sim.cli.common import PROG
 from landing_gear_sim.errors import LandingGearSimError
 
@@ -29,6 +30,7 @@ def build_parser() -> argparse.ArgumentParser:
     model.register(sub)
     analysis.register(sub)
     fleet.register(sub)
+    montecarlo.register(sub)
     return parser
 
 

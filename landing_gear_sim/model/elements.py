@@ -46,6 +46,11 @@ RADIUS_C = INDEX["radius.c_m"]
 THETA1 = INDEX["friction.theta1"]
 THETA2 = INDEX["friction.theta2"]
 THETA3 = INDEX["friction.theta3"]
+CHANGE_SPEED = INDEX["friction.change_speed_m_s"]
+AFTER_THETA1 = INDEX["friction.after_theta1"]
+# each surface's (ϑ1, ϑ2, ϑ3) are read as three consecutive entries
+assert INDEX["friction.theta3"] == THETA1 + 2
+assert INDEX["friction.after_theta3"] == AFTER_THETA1 + 2
 GW_LENGTH = INDEX["gear_walk.length_m"]
 GW_INERTIA = INDEX["gear_walk.inertia_kg_m2"]
 GW_STIFFNESS = INDEX["gear_walk.stiffness_n_m_per_rad"]
@@ -73,17 +78,25 @@ def burckhardt_mu(theta1, theta2, theta3, slip):
 
 
 @njit(cache=True)
-def burckhardt(p, slip):
-    """Friction coefficient μ(λ) of the parameter set, extended odd for λ < 0 (wheel faster
-    than hub)."""
-    mu = burckhardt_mu(p[THETA1], p[THETA2], p[THETA3], abs(slip))
+def burckhardt(p, slip, speed_m_s):
+    """Friction coefficient μ(λ) of the surface under the tyre at vehicle speed
+    ``speed_m_s``, extended odd for λ < 0 (wheel faster than hub). Below
+    ``friction.change_speed_m_s`` (when > 0) the tyre is on the second surface: a stop
+    decelerates monotonically, so a speed marks a place on the runway."""
+    first = THETA1
+    if p[CHANGE_SPEED] > 0.0 and speed_m_s < p[CHANGE_SPEED]:
+        first = AFTER_THETA1
+    mu = burckhardt_mu(p[first], p[first + 1], p[first + 2], abs(slip))
     return mu if slip >= 0.0 else -mu
 
 
 @njit(cache=True)
 def burckhardt_slope_max(p):
-    """Largest |dμ/dλ| of the curve (at λ = 0): the tyre's stiffest point."""
-    return p[THETA1] * p[THETA2] + p[THETA3]
+    """Largest |dμ/dλ| of the curves (at λ = 0): the tyre's stiffest point."""
+    slope = p[THETA1] * p[THETA2] + p[THETA3]
+    if p[CHANGE_SPEED] > 0.0:
+        slope = max(slope, p[AFTER_THETA1] * p[AFTER_THETA1 + 1] + p[AFTER_THETA1 + 2])
+    return slope
 
 
 @njit(cache=True)

@@ -121,6 +121,15 @@ SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("sensors.wheel_speed_delay_s", "s",
               "the wheel-speed channel reads the wheel this much earlier than the others are "
               "read (a logger channel out of step; 0: none)", default=0.0),
+    ParamSpec("friction.change_speed_m_s", "m/s",
+              "below this vehicle speed the tyre runs on a second surface, friction.after_* "
+              "(a mu-jump mid-stop: a wet or icy patch; 0: one surface)", default=0.0),
+    ParamSpec("friction.after_theta1", "-", "Burckhardt theta1 of the second surface",
+              default=0.0),
+    ParamSpec("friction.after_theta2", "-", "Burckhardt theta2 of the second surface",
+              default=0.0),
+    ParamSpec("friction.after_theta3", "-", "Burckhardt theta3 of the second surface",
+              default=0.0),
 )
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}

@@ -56,7 +56,10 @@ def tyre_state(p, x, vertical_load_n):
     radius = el.rolling_radius(p, vertical_load_n)
     hub = x[SPEED] - p[el.GW_LENGTH] * x[ANGLE_RATE] if p[el.HAS_GEAR_WALK] else x[SPEED]
     slip = el.slip_ratio(hub, x[OMEGA], radius)
-    force = x[TYRE_FORCE] if p[el.HAS_RELAXATION] else vertical_load_n * el.burckhardt(p, slip)
+    if p[el.HAS_RELAXATION]:
+        force = x[TYRE_FORCE]
+    else:
+        force = vertical_load_n * el.burckhardt(p, slip, x[SPEED])
     return radius, hub, slip, force
 
 
@@ -87,7 +90,7 @@ def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     dx[E_DRAG] = drag * x[SPEED]
     dx[E_SLIP] = fx * (hub - x[OMEGA] * radius)
     dx[E_DAMP] = p[el.GW_DAMPING] * x[ANGLE_RATE] ** 2 if p[el.HAS_GEAR_WALK] else 0.0
-    steady = vertical_load_n * el.burckhardt(p, slip)
+    steady = vertical_load_n * el.burckhardt(p, slip, x[SPEED])
     dx[TYRE_FORCE] = el.relaxation_rate(p, hub) * (steady - x[TYRE_FORCE])
 
 

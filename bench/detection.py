@@ -114,6 +114,12 @@ FAMILIES: dict[str, Case] = {
     "channel_skew": Case(
         lambda r, d: {"sensors.wheel_speed_delay_s": r.uniform(0.005, 0.03)},
         "wheel_speed_delay_s", _number("sensors.wheel_speed_delay_s"), 1e-3, absolute=True),
+    "run_drift": Case(
+        lambda r, d: {"brake.gain_drift_per_run": r.choice([-1, 1]) * r.uniform(0.015, 0.04)},
+        "gain_drift_per_run", _number("brake.gain_drift_per_run"), 0.2),
+    "input_history": Case(
+        lambda r, d: {"actuator.backlash_a": r.uniform(0.004, 0.04)},
+        "backlash_a", _number("actuator.backlash_a"), 0.2),
 }
 
 

@@ -7,6 +7,7 @@ import pytest
 
 from landing_gear_sim.errors import ParameterError
 from landing_gear_sim.model import scenario as sc
+from landing_gear_sim.model.actuator import actuator_pressure
 from landing_gear_sim.model.integrate import simulate
 
 
@@ -110,6 +111,21 @@ def test_faded_brake_torque_follows_the_absorbed_energy(reference):
     assert np.allclose(result.brake_torque_n_m, expected, rtol=1e-12, atol=1e-9)
     plain = simulate(reference, sc.constant_pressure_test(reference, 30e5))
     assert result.time_s[-1] > 1.1 * plain.time_s[-1]  # a fading brake stops later
+
+
+def test_a_valve_with_play_sees_the_current_half_the_play_late_each_way(reference):
+    """The play operator: on a slow ramp up the valve sees i − w/2, on the way down
+    i + w/2, so the pressure is the play-free valve's at those currents."""
+    ramp = np.concatenate([np.linspace(0.0, 1.0, 20000), np.linspace(1.0, 0.0, 20000)])
+    width = 0.04
+    pressure = actuator_pressure(reference.replace({"actuator.backlash_a": width}), ramp,
+                                 1000.0)
+    up, down = slice(6000, 14000), slice(26000, 34000)
+    for part, shift in ((up, -width / 2), (down, width / 2)):
+        expected = actuator_pressure(reference, ramp + shift, 1000.0)[part]
+        np.testing.assert_allclose(pressure[part], expected, rtol=1e-9, atol=1e-3)
+    play_free = actuator_pressure(reference, ramp, 1000.0)
+    assert pressure[down].mean() - play_free[down].mean() > 1e5  # ~k1·w/2: a bar and more
 
 
 def test_fade_fraction_below_one(reference):

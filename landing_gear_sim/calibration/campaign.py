@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from landing_gear_sim.calibration.measured import run_parameters
 from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import RigParameters
@@ -53,6 +54,12 @@ def standard_scenarios(p: RigParameters) -> dict[str, sc.Scenario]:
     }
 
 
+def _campaign_order(braking: Sequence[str]) -> dict[str, float]:
+    """Each braking run's place in run order (file-name order), about the middle one."""
+    ordered = sorted(braking)
+    return {name: rank - (len(ordered) - 1) / 2 for rank, name in enumerate(ordered)}
+
+
 def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,
                       names: Sequence[str] | None = None) -> list[Path]:
     """Simulate and write the standard runs of ``rig`` (or those in ``names``) into
@@ -60,10 +67,14 @@ def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     written = []
-    for i, (name, scenario) in enumerate(standard_scenarios(rig).items()):
+    scenarios = standard_scenarios(rig)
+    order = _campaign_order([n for n, s in scenarios.items() if s.contact
+                             and (names is None or n in names)])
+    for i, (name, scenario) in enumerate(scenarios.items()):
         if names is not None and name not in names:
             continue
-        run = simulate(rig, scenario).to_run(noise=seed * 100 + i)
+        params = run_parameters(rig, order.get(name, 0.0))
+        run = simulate(params, scenario).to_run(noise=seed * 100 + i)
         path = folder / f"{name}.csv"
         write_csv(run, path)
         written.append(path)

@@ -48,6 +48,20 @@ def scenario_for_run(run: ClassifiedRun, params: RigParameters) -> Scenario:
                     "measured input")
 
 
+GAIN = "brake.gain_n_m_per_pa"
+DRIFT = "brake.gain_drift_per_run"
+
+
+def run_parameters(params: RigParameters, campaign_order: float) -> RigParameters:
+    """The set a run at ``campaign_order`` (see ClassifiedRun) brakes with: k_b moved by
+    ``brake.gain_drift_per_run`` per run from the middle run's (wear through a campaign)."""
+    drift = params.number(DRIFT)
+    if drift == 0.0 or campaign_order == 0.0:
+        return params
+    return params.replace({GAIN: params.number(GAIN) * (1.0 + drift * campaign_order)},
+                          "run in the campaign")
+
+
 def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult]:
     """Simulate ``run`` with its measured current; the result on the run's (uniform, see
     :func:`~landing_gear_sim.calibration.runs.classified`) time base.
@@ -58,6 +72,7 @@ def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult
     start, as in the rig procedure.
     """
     run = classified(run)
+    params = run_parameters(params, run.campaign_order)
     result = simulate(params, scenario_for_run(run, params))
     simulated = result.to_run()
     n, m = len(run), len(simulated)

@@ -93,6 +93,9 @@ class ClassifiedRun(Run):
 
     kind: RunKind = dataclasses.field(kw_only=True)
     brake_start_s: float = dataclasses.field(kw_only=True)
+    campaign_order: float = dataclasses.field(kw_only=True, default=0.0)
+    """Place among the campaign's braking runs in run order, about the middle one
+    (−1, 0, 1 for three); 0 for a run classified on its own or one that does not brake."""
 
     @classmethod
     def of(cls, run: Run) -> ClassifiedRun:
@@ -144,7 +147,17 @@ def classified(run: Run) -> ClassifiedRun:
 
 
 def classify_all(runs: Iterable[Run]) -> list[ClassifiedRun]:
-    return [classified(r) for r in runs]
+    """The runs of one campaign (in run order) classified, each braking run with its
+    ``campaign_order``; runs classified already keep theirs (a subset must not renumber)."""
+    given = list(runs)
+    done = [classified(r) for r in given]
+    if any(isinstance(r, ClassifiedRun) for r in given):
+        return done
+    braking = [i for i, r in enumerate(done) if r.braking]
+    middle = (len(braking) - 1) / 2
+    for rank, i in enumerate(braking):
+        done[i] = dataclasses.replace(done[i], campaign_order=rank - middle)
+    return done
 
 
 def select(runs: Sequence[ClassifiedRun], selectors: Iterable[Selector]) -> list[ClassifiedRun]:

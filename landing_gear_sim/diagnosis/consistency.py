@@ -8,6 +8,8 @@ curve, the brake gain or the drag to swallow an effect the relations still show)
 * free rolling (no brake): the load cell's F_x is the wheel's own inertia, J_w ω̇ / r;
 * zero current ⇒ zero pressure (once the valve has settled);
 * no contact (actuator-only runs) ⇒ zero loads;
+* the valve's pressure against the model's, where the current changes slowly, does not
+  depend on whether the current last rose or fell (play, hysteresis: ``input_history``);
 * the brake gain of the wheel's torque balance r F_x − J_w ω̇ = k_b P does not depend on
   the speed or on the pressure level (a local k_b, fitted with a linear trend), nor on the
   run (k_b of each run, in the campaign's run order: wear, a brake that beds in).
@@ -34,8 +36,10 @@ from landing_gear_sim.calibration.statistics import (
 )
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.scoring import effective_count
+from landing_gear_sim.model.actuator import actuator_pressure
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rolling_radius_at
+from landing_gear_sim.model.scenario import logged_to_held
 from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.units import PA_PER_BAR
 
@@ -50,6 +54,8 @@ FREE_ROLLING = "free rolling ⇒ F_x = J_w ω̇ / r"
 GAIN_IN_SPEED = "brake gain constant in speed"
 GAIN_IN_PRESSURE = "brake gain linear in pressure"
 RUN_DRIFT = "brake gain constant from run to run"
+VALVE_DIRECTION = "valve the same with the current rising and falling"
+SLOW_A_S = 0.5  # slower current changes: A(s) errors leave no direction-locked residual
 
 
 @dataclass(frozen=True)
@@ -122,7 +128,32 @@ def _run_checks(run: ClassifiedRun, prepared: br.Braking | None, params: RigPara
                                   getattr(run, name), FORCE_FLOOR_N, "N", label)
                       for name, label in (("vertical_load_n", "F_z"),
                                           ("longitudinal_force_n", "F_x")))
+        checks.append(_valve_direction(run, params))
     return [c for c in checks if c is not None]
+
+
+def _valve_direction(run: ClassifiedRun, params: RigParameters) -> Check | None:
+    """Measured minus model pressure where the current fell last, against where it rose
+    last (only where it has changed slowly for SETTLED_S and the valve is between its
+    dead-band and saturation): a static map cannot tell the two apart, a valve with play
+    can. Positive: more pressure on the way down."""
+    model = actuator_pressure(params, logged_to_held(run.current_a), run.rate_hz)
+    residual = SensorModel.of(params).true_pressure(run.pressure_pa) - model
+    change = np.diff(run.current_a, prepend=run.current_a[0])
+    last = np.maximum.accumulate(np.where(change != 0.0, np.arange(change.size), 0))
+    direction = np.sign(change[last])
+    window = max(1, round(SETTLED_S * run.rate_hz))
+    fast = np.abs(change) * run.rate_hz > SLOW_A_S
+    slow = np.convolve(fast, np.ones(window), mode="full")[:fast.size] == 0
+    band = (model > 2 * PRESSURE_FLOOR_PA) & (model < 0.9 * params.number(
+        "actuator.max_pressure_pa"))
+    falling, rising = (residual[slow & band & (direction == s)] for s in (-1.0, 1.0))
+    if min(falling.size, rising.size) < MIN_SAMPLES:
+        return None
+    std = math.sqrt(sum(float(np.var(r)) / effective_count(r - r.mean())
+                        for r in (falling, rising)))
+    return Check(VALVE_DIRECTION, run.name, "slow current changes",
+                 float(falling.mean() - rising.mean()), std, PRESSURE_FLOOR_PA, "Pa")
 
 
 def _mean_check(relation: str, run: str, phase: str, values: np.ndarray, floor: float,
@@ -166,12 +197,14 @@ def _gain_trends(runs: Sequence[br.Braking], params: RigParameters) -> list[Chec
     """k_b of the torque balance with a linear trend in speed, and in pressure, over the
     braking runs: the relative change over the range seen [1]."""
     torque, pressure, speed = [], [], []
+    drift = params.number("brake.gain_drift_per_run")
     for b in runs:
         whole, _ = br.torque_balance(b, params)
         m = br.steady_braking_samples(b)
-        # relative to the model's own law: a gain slope the model has is no violation
+        # relative to the model's own law: a gain slope or drift it has is no violation
         whole = whole / (1.0 + params.number("brake.gain_slope_wheel_speed_s_per_rad") * b.wheel
                          + params.number("brake.gain_slope_pressure_per_pa") * b.pressure)
+        whole = whole / (1.0 + drift * b.run.campaign_order)
         torque.append(whole[m][::10])
         pressure.append(b.pressure[m][::10])
         speed.append(b.speed_m_s[m][::10])

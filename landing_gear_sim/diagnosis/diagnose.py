@@ -18,11 +18,11 @@ from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field, replace
 
-from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.identify import Progress, identify
 from landing_gear_sim.calibration.measured import CHANNELS, simulate_all
 from landing_gear_sim.calibration.runs import ClassifiedRun, classify_all
 from landing_gear_sim.calibration.statistics import Estimate
+from landing_gear_sim.diagnosis import discovered
 from landing_gear_sim.diagnosis.catalogue import (
     CATALOGUE,
     Candidate,
@@ -32,25 +32,14 @@ from landing_gear_sim.diagnosis.catalogue import (
     switched_on,
 )
 from landing_gear_sim.diagnosis.consistency import (
-    FREE_ROLLING,
-    GAIN_IN_PRESSURE,
-    GAIN_IN_SPEED,
     Check,
     check_campaign,
     inconsistent,
     violations,
 )
-from landing_gear_sim.diagnosis.discovery import (
-    channel_candidate,
-    discovered_candidate,
-    families,
-    select_brake_terms,
-    select_channel_terms,
-    skew_candidate,
-    term_formula,
-)
-from landing_gear_sim.diagnosis.findings import Finding, Signature, SignatureKind
+from landing_gear_sim.diagnosis.findings import Finding, Signature
 from landing_gear_sim.diagnosis.identifiability import actuator_calibrated, untestable
+from landing_gear_sim.diagnosis.local import LocalGain, local_gains
 from landing_gear_sim.diagnosis.scoring import (
     BIC_THRESHOLD,
     Scored,
@@ -95,6 +84,10 @@ class Diagnosis:
     """The relations the rig measures twice, checked under the extended model."""
     estimates: tuple[Estimate, ...] = ()
     """The starting model's calibration on the campaign: value and 1-σ per parameter."""
+    local_before: list[LocalGain] = field(default_factory=list)
+    """k_b re-estimated per band and along each run, over the calibrated model's gain."""
+    local_after: list[LocalGain] = field(default_factory=list)
+    """The same over the extended model's gain."""
 
     def to_json(self) -> dict[str, object]:
         return {"verdict": self.verdict, "findings": [f.to_json() for f in self.findings],
@@ -103,6 +96,8 @@ class Diagnosis:
                 "signatures_before": [s.describe() for s in self.signatures_before],
                 "signatures_after": [s.describe() for s in self.signatures_after],
                 "consistency": [c.to_json() for c in self.consistency],
+                "local_gains": {"calibrated": [g.to_json() for g in self.local_before],
+                                "extended": [g.to_json() for g in self.local_after]},
                 "problems": self.problems}
 
 
@@ -162,6 +157,14 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
                 scored.append(outcome)
         table.extend(s.finding for s in scored)
         winners = [s for s in scored if s.finding.accepted]
+        if round_ == 1 and winners:
+            rival = discovered.rival(runs, model, base, scales, before, say)
+            if rival is not None:
+                table.append(rival.finding)
+                if discovered.beats(rival, winners, runs):
+                    say(f"accepted a discovered term: {rival.finding.term}")
+                    accepted, model = [rival], rival.fit.params
+                    break
         if not winners:
             break
         best = min(winners, key=lambda s: s.finding.delta_bic or 0.0)
@@ -174,7 +177,7 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     say("checking the relations the rig measures twice")
     checks = check_campaign(runs, model)
     if not accepted:
-        found = _discover(runs, model, base, scales, before, checks, say)
+        found = discovered.discover(runs, model, base, scales, before, checks, say)
         if found is not None:
             table.append(found.finding)
             if found.finding.accepted:
@@ -202,52 +205,8 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     evidence = [run_evidence(*sims, calibrated)
                 for sims in zip(runs, simulated_before, simulated_after, strict=True)]
     return Diagnosis(verdict, findings, table, baseline, start, calibrated, model,
-                     before, after, problems, evidence, checks, calibration.estimates)
-
-
-def _discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: RigParameters,
-              scales: Scales, signatures: Sequence[Signature], checks: Sequence[Check],
-              say: Progress) -> Scored | None:
-    """A discovered term, scored, when relations among ``checks`` (of ``model``) are
-    violated and the sparse regression keeps a term, or the wheel channel lags the model
-    (None otherwise): the channels first (what they misread distorts the brake-gain
-    relations too), then the brake torque."""
-    broken = {c.relation for c in violations(checks)}
-    scored = None
-    lags = [s.value for s in signatures if s.kind is SignatureKind.LAG
-            and s.channel == "wheel_speed_rad_s" and s.value > 0]
-    if lags:
-        scored = _score_discovered(skew_candidate(lags[0]), runs, model, datasheet, scales,
-                                   signatures, say)
-    libraries = {FREE_ROLLING, GAIN_IN_SPEED, GAIN_IN_PRESSURE}  # relations they explain
-    # filtered once for both libraries, and only when one of them will be asked
-    braking = [br.prepare(r, model) for r in runs if r.braking] if broken & libraries else []
-    if FREE_ROLLING in broken and (scored is None or not scored.finding.accepted):
-        channels = select_channel_terms(runs, braking, model)
-        if channels:
-            scored = _score_discovered(channel_candidate(channels), runs, model, datasheet,
-                                       scales, signatures, say)
-    # the gain's law in speed and pressure (a drift from run to run has no term yet)
-    if (scored is None or not scored.finding.accepted) and broken & {GAIN_IN_SPEED,
-                                                                     GAIN_IN_PRESSURE}:
-        terms = select_brake_terms(braking, model)
-        if terms:
-            scored = _score_discovered(discovered_candidate(terms), runs, model, datasheet,
-                                       scales, signatures, say) or scored
-    return scored
-
-
-def _score_discovered(candidate: Candidate, runs: Sequence[ClassifiedRun],
-                      model: RigParameters, datasheet: RigParameters, scales: Scales,
-                      signatures: Sequence[Signature], say: Progress) -> Scored | None:
-    say(f"fitting a discovered term: {families(candidate)}")
-    try:
-        scored = score_candidate(candidate, runs, model, datasheet, scales, signatures)
-    except IdentificationError:
-        return None
-    finding = replace(scored.finding, family=families(candidate),
-                      term=term_formula(candidate, scored.fit.params))
-    return Scored(finding, scored.fit)
+                     before, after, problems, evidence, checks, calibration.estimates,
+                     local_gains(runs, calibrated), local_gains(runs, model))
 
 
 def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],

@@ -1,4 +1,5 @@
-"""Discovery of terms the catalogue lacks (issue 14, part 3: brake torque, load-cell channels).
+"""Discovery of terms the catalogue lacks (issue 14, part 3: brake torque, load-cell channels,
+the wheel channel's timing, the valve's play).
 
 When the brake-gain consistency checks are violated, the wheel's torque balance
 r F_x − J_w ω̇ = k_b P (1 + Σ c_i x_i) is regressed on a library of physical terms x_i
@@ -23,7 +24,15 @@ import numpy as np
 
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun
-from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
+from landing_gear_sim.diagnosis.catalogue import (
+    ACTUATOR_RUNS,
+    BRAKE_RUNS,
+    FRICTION,
+    PRESSURE,
+    STATIC_MAP,
+    WHEEL,
+    Candidate,
+)
 from landing_gear_sim.diagnosis.consistency import FORCE_FLOOR_N, free_rolling_excess
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import PA_PER_BAR
@@ -155,6 +164,36 @@ def skew_candidate(lag_s: float) -> Candidate:
                      BRAKE_RUNS, WHEEL, (), (("wheel_speed_delay_s", SKEW_KEY),))
 
 
+BACKLASH_KEY = "actuator.backlash_a"
+BACKLASH_BOUNDS = (0.0, 0.2)  # A: a fifth of the valve's range
+
+
+def backlash_candidate(excess_pa: float, params: RigParameters) -> Candidate:
+    """A valve with play (``input_history``): it sees the current only once that has moved
+    the backlash w the other way, so on the way down it holds ``excess_pa`` more than on
+    the way up, ≈ k1·w. Fitted with the static map (fitted across both directions, it
+    averaged the play away) on the actuator runs, checked on the braking runs' pressure."""
+    start = min(max(excess_pa / params.number("actuator.map_k1_pa_per_a"), 1e-3),
+                BACKLASH_BOUNDS[1])
+    return Candidate(DISCOVERED, None, (BACKLASH_KEY,), ((start,),), (BACKLASH_BOUNDS,),
+                     STATIC_MAP, ACTUATOR_RUNS, PRESSURE, BRAKE_RUNS,
+                     (("backlash_a", BACKLASH_KEY),))
+
+
+DRIFT_KEY = "brake.gain_drift_per_run"
+DRIFT_BOUNDS = (-0.2, 0.2)  # per run: a fifth of k_b from one run to the next at most
+
+
+def drift_candidate(change: float, braking_runs: int) -> Candidate:
+    """k_b moving from one braking run to the next (``run_drift``: wear, bedding in),
+    started at the consistency check's first-to-last ``change`` spread over the runs and
+    fitted with k_b and the friction curve; checked on half the braking runs."""
+    start = change / max(braking_runs - 1, 1)
+    return Candidate(DISCOVERED, None, (DRIFT_KEY,), ((start,),), (DRIFT_BOUNDS,),
+                     ("brake.gain_n_m_per_pa", *FRICTION), BRAKE_RUNS, WHEEL, (),
+                     (("gain_drift_per_run", DRIFT_KEY),))
+
+
 def discovered_candidate(terms: dict[LibraryTerm, float]) -> Candidate:
     """The kept brake terms as a candidate, fitted with k_b and the friction curve."""
     return _term_candidate(terms, ("brake.gain_n_m_per_pa", *FRICTION), WHEEL)
@@ -174,6 +213,10 @@ def _term_candidate(terms: Mapping[TermT, float], free: tuple[str, ...],
 def families(candidate: Candidate) -> str:
     if SKEW_KEY in candidate.keys:
         return "channel_skew"
+    if BACKLASH_KEY in candidate.keys:
+        return "input_history"
+    if DRIFT_KEY in candidate.keys:
+        return "run_drift"
     return "+".join(t.family for t in (*BRAKE_LIBRARY, *CHANNEL_LIBRARY)
                     if t.key in candidate.keys)
 
@@ -183,6 +226,13 @@ def term_formula(candidate: Candidate, params: RigParameters) -> str:
     ``F_x,read = F_x + 0.0123·F_z``."""
     if SKEW_KEY in candidate.keys:
         return f"ω_read(t) = ω(t − {1e3 * params.number(SKEW_KEY):.1f} ms)"
+    if BACKLASH_KEY in candidate.keys:
+        half = 500 * params.number(BACKLASH_KEY)
+        return f"P_static = map(i_v), i_v = play(i, ±{half:.1f} mA)"
+    if DRIFT_KEY in candidate.keys:
+        gain = params.number("brake.gain_n_m_per_pa") * PA_PER_BAR
+        return (f"k_b,i = {gain:.4g} N m/bar·(1 {100 * params.number(DRIFT_KEY):+.2f} %·"
+                "(i − ī)), i: braking run in run order")
     channels = [t for t in CHANNEL_LIBRARY if t.key in candidate.keys]
     if channels:
         values = [params.number(t.key) for t in channels]

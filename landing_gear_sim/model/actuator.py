@@ -24,6 +24,8 @@ _ACT_GAIN = INDEX["actuator.gain"]
 _ACT_WN = INDEX["actuator.natural_frequency_hz"]
 _ACT_ZETA = INDEX["actuator.damping_ratio"]
 _ACT_DELAY = INDEX["actuator.delay_s"]
+_BACKLASH = INDEX["actuator.backlash_a"]
+PLAY = 2  # actuator state: pressure, rate, the current the valve sees, static pressures
 
 
 def second_order_system(natural_frequency_hz: float, damping_ratio: float, gain: float
@@ -99,18 +101,32 @@ def _matrices(natural_frequency_hz: float, damping_ratio: float, gain: float, de
 
 @njit(cache=True)
 def actuator_state(matrices):
-    """Zero actuator state: pressure, rate, then the static pressures of recent steps."""
-    return np.zeros(2 + int(matrices[ACT_DELAY_STEPS]) + 2)
+    """Zero actuator state: pressure, rate, the current the valve sees (after its play),
+    then the static pressures of recent steps."""
+    return np.zeros(PLAY + 1 + int(matrices[ACT_DELAY_STEPS]) + 2)
+
+
+@njit(cache=True)
+def valve_play(backlash_a, seen_a, current_a):
+    """The current the valve sees after its play: it follows ``current_a`` only once that
+    is more than half the backlash away (a play operator; ``seen_a`` is the last one)."""
+    half = 0.5 * backlash_a
+    return min(max(seen_a, current_a - half), current_a + half)
 
 
 @njit(cache=True)
 def actuator_step(p, matrices, xa, current_a):
     """Advance the actuator state ``xa`` one step with ``current_a`` held; return P [Pa]."""
-    for j in range(xa.size - 1, 2, -1):  # shift register of static-map pressures
+    first = PLAY + 1
+    for j in range(xa.size - 1, first, -1):  # shift register of static-map pressures
         xa[j] = xa[j - 1]
-    xa[2] = el.valve_static_pressure(p, current_a)
+    seen = current_a
+    if p[_BACKLASH] > 0.0:
+        seen = valve_play(p[_BACKLASH], xa[PLAY], current_a)
+        xa[PLAY] = seen
+    xa[first] = el.valve_static_pressure(p, seen)
     whole = int(matrices[ACT_DELAY_STEPS])
-    newer, older = xa[2 + whole], xa[3 + whole]
+    newer, older = xa[first + whole], xa[first + 1 + whole]
     if p[el.HAS_ACTUATOR_DYNAMICS] == 0.0:
         xa[0], xa[1] = p[_ACT_GAIN] * newer, 0.0
         return xa[0]

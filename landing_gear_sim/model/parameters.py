@@ -130,6 +130,14 @@ SPECS: tuple[ParamSpec, ...] = (
               default=0.0),
     ParamSpec("friction.after_theta3", "-", "Burckhardt theta3 of the second surface",
               default=0.0),
+    ParamSpec("actuator.backlash_a", "A",
+              "play of the valve in current: the static map sees the current only once it "
+              "has moved this much the other way (a hysteresis the catalogue lacks; 0: none)",
+              default=0.0),
+    ParamSpec("brake.gain_drift_per_run", "-",
+              "relative change of k_b from one braking run of a campaign to the next, in run "
+              "order, about the middle run (wear; a campaign-level term: a run simulated on "
+              "its own has the middle run's k_b; 0: none)", signed=True, default=0.0),
 )
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}

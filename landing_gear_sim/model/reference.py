@@ -103,3 +103,6 @@ def _check_modelled(params: RigParameters) -> None:
             state = "on" if unsupported else "off"
             raise ParameterError(f"the reference solution does not model elements.{element} "
                                  f"{state}; compare without it")
+    if params.number("actuator.backlash_a") > 0.0:
+        raise ParameterError("the reference solution does not model the valve's "
+                             "actuator.backlash_a; compare without it")

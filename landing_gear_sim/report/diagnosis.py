@@ -16,6 +16,7 @@ from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
 from landing_gear_sim.diagnosis.residuals import Spectrum
 from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, HELD_OUT_THRESHOLD
 from landing_gear_sim.report.figures import DISPLAY_UNITS, save_figure
+from landing_gear_sim.report.local import local_gain_section
 from landing_gear_sim.report.pages import html_image, html_table, text_table, write_html
 from msg_tools.run import Run
 
@@ -113,6 +114,8 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
                     + [["extended model", s.describe()] for s in result.signatures_after]))]
     if result.consistency:
         sections.append(_consistency_section(result.consistency, folder))
+    if result.local_before or result.local_after:
+        sections.append(local_gain_section(result.local_before, result.local_after, folder))
     for item in result.evidence:
         run = item.run
         channels = (("pressure_pa", "wheel_speed_rad_s", "longitudinal_force_n") if run.braking

@@ -1,0 +1,145 @@
+"""The discovered term a campaign calls for (issue 14), chosen and scored.
+
+The relations the calibrated model violates say where to look
+(:mod:`~landing_gear_sim.diagnosis.consistency`); the libraries and candidates of
+:mod:`~landing_gear_sim.diagnosis.discovery` say what to try; each is scored exactly like a
+catalogue candidate. In round 1 the term the calibrated model calls for is also scored
+beside the catalogue's winners (:func:`rival`), so that a law the catalogue lacks is never
+reported under the name of a catalogued effect that bent to it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+
+from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration.identify import Progress
+from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.diagnosis.catalogue import Candidate, Scales
+from landing_gear_sim.diagnosis.consistency import (
+    FREE_ROLLING,
+    GAIN_IN_PRESSURE,
+    GAIN_IN_SPEED,
+    RUN_DRIFT,
+    VALVE_DIRECTION,
+    Check,
+    check_campaign,
+    violations,
+)
+from landing_gear_sim.diagnosis.discovery import (
+    backlash_candidate,
+    channel_candidate,
+    discovered_candidate,
+    drift_candidate,
+    families,
+    select_brake_terms,
+    select_channel_terms,
+    skew_candidate,
+    term_formula,
+)
+from landing_gear_sim.diagnosis.findings import Signature, SignatureKind
+from landing_gear_sim.diagnosis.scoring import Scored, score_candidate
+from landing_gear_sim.errors import IdentificationError
+from landing_gear_sim.model.parameters import RigParameters
+
+
+def discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: RigParameters,
+              scales: Scales, signatures: Sequence[Signature], checks: Sequence[Check],
+              say: Progress) -> Scored | None:
+    """A discovered term, scored, when relations among ``checks`` (of ``model``) are
+    violated and the sparse regression keeps a term, or the wheel channel lags the model
+    (None otherwise): the channels first (what they misread distorts the brake-gain
+    relations too), then the brake torque."""
+    broken = {c.relation for c in violations(checks)}
+    scored = None
+    excess = [c.deviation for c in violations(checks) if c.relation == VALVE_DIRECTION]
+    if excess and max(excess) > 0:  # the valve first: what it misreads reaches every run
+        scored = _score_discovered(backlash_candidate(max(excess), model), runs, model,
+                                   datasheet, scales, signatures, say)
+    lags = [s.value for s in signatures if s.kind is SignatureKind.LAG
+            and s.channel == "wheel_speed_rad_s" and s.value > 0]
+    if lags and (scored is None or not scored.finding.accepted):
+        scored = _score_discovered(skew_candidate(lags[0]), runs, model, datasheet, scales,
+                                   signatures, say)
+    libraries = {FREE_ROLLING, GAIN_IN_SPEED, GAIN_IN_PRESSURE}  # relations they explain
+    # filtered once for both libraries, and only when one of them will be asked
+    braking = [br.prepare(r, model) for r in runs if r.braking] if broken & libraries else []
+    if FREE_ROLLING in broken and (scored is None or not scored.finding.accepted):
+        channels = select_channel_terms(runs, braking, model)
+        if channels:
+            scored = _score_discovered(channel_candidate(channels), runs, model, datasheet,
+                                       scales, signatures, say)
+    if scored is None or not scored.finding.accepted:
+        for candidate in _gain_candidates(runs, braking, model, checks):
+            scored = _better(scored, _score_discovered(candidate, runs, model, datasheet,
+                                                       scales, signatures, say))
+    return scored
+
+
+def _gain_candidates(runs: Sequence[ClassifiedRun], braking: Sequence[br.Braking],
+                     model: RigParameters, checks: Sequence[Check]) -> list[Candidate]:
+    """The brake gain's law in speed and pressure, and its drift from run to run, as the
+    violated relations call for them: both are scored when both are (pressure levels in
+    run order make a drift look like a pressure law, and the reverse)."""
+    broken = {c.relation: c for c in reversed(violations(checks))}
+    candidates = []
+    if GAIN_IN_SPEED in broken or GAIN_IN_PRESSURE in broken:
+        terms = select_brake_terms(braking, model)
+        if terms:
+            candidates.append(discovered_candidate(terms))
+    if RUN_DRIFT in broken:
+        candidates.append(drift_candidate(broken[RUN_DRIFT].deviation,
+                                          sum(r.braking for r in runs)))
+    return candidates
+
+
+def _better(first: Scored | None, second: Scored | None) -> Scored | None:
+    """The accepted one, or of two accepted (or two not) the one with the lower ΔBIC."""
+    if first is None or second is None:
+        return first or second
+    def rank(s: Scored) -> tuple[bool, float]:
+        return not s.finding.accepted, s.finding.delta_bic or 0.0
+    return min(first, second, key=rank)
+
+
+def rival(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: RigParameters,
+           scales: Scales, signatures: Sequence[Signature], say: Progress) -> Scored | None:
+    """The discovered term the calibrated ``model`` calls for, to be scored beside the
+    catalogue's first winners: a law the catalogue lacks may be fitted nearly as well by a
+    catalogued effect (a torque not linear in pressure by brake fade), and only the
+    comparison tells them apart. None when no relation is violated."""
+    checks = check_campaign(runs, model)
+    if not violations(checks):
+        return None
+    return discover(runs, model, datasheet, scales, signatures, checks, say)
+
+
+def beats(rival: Scored, winners: Sequence[Scored], runs: Sequence[ClassifiedRun]) -> bool:
+    """Whether the discovered rival, accepted on its own, explains the campaign better than
+    the best catalogued winner: by ΔBIC, or — since a catalogued effect may bend in sample
+    to a law it is not (brake fade to a torque not linear in pressure) — on the held-out
+    runs and in the relations the rig measures twice, where it cannot."""
+    best = min(winners, key=lambda s: s.finding.delta_bic or 0.0)
+    if not rival.finding.accepted:
+        return False
+    if (rival.finding.delta_bic or 0.0) < (best.finding.delta_bic or 0.0):
+        return True
+    if rival.finding.held_out is None or best.finding.held_out is None \
+            or rival.finding.held_out >= best.finding.held_out:
+        return False
+    left = len(violations(check_campaign(runs, best.fit.params)))
+    return len(violations(check_campaign(runs, rival.fit.params))) < left
+
+
+def _score_discovered(candidate: Candidate, runs: Sequence[ClassifiedRun],
+                      model: RigParameters, datasheet: RigParameters, scales: Scales,
+                      signatures: Sequence[Signature], say: Progress) -> Scored | None:
+    say(f"fitting a discovered term: {families(candidate)}")
+    try:
+        scored = score_candidate(candidate, runs, model, datasheet, scales, signatures)
+    except IdentificationError:
+        return None
+    finding = replace(scored.finding, family=families(candidate),
+                      term=term_formula(candidate, scored.fit.params))
+    return Scored(finding, scored.fit)

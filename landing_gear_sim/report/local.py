@@ -1,0 +1,52 @@
+"""The brake gain re-estimated locally, as a figure: per band of each physical variable
+(calibrated and extended model side by side) and along each run. Takes the estimates
+(:mod:`landing_gear_sim.diagnosis.local`), never recomputes them."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+
+from landing_gear_sim.diagnosis.local import VARIABLES, LocalGain
+from landing_gear_sim.report.figures import save_figure
+from landing_gear_sim.report.pages import html_image, html_table
+
+
+def plot_local_gains(before: Sequence[LocalGain], after: Sequence[LocalGain], path: Path
+                     ) -> Path:
+    """One panel per variable of VARIABLES (k_b over the model's, ±1σ, per band; calibrated
+    and extended model), and one of the estimates along each run (calibrated model)."""
+    fig, axes = plt.subplots(1, len(VARIABLES) + 1, figsize=(4 * (len(VARIABLES) + 1), 3.6),
+                             sharey=True)
+    for ax, variable in zip(axes, VARIABLES, strict=False):
+        for gains, label, colour in ((before, "calibrated", "tab:red"),
+                                     (after, "extended", "tab:blue")):
+            for g in (g for g in gains if g.variable == variable):
+                ax.errorbar(g.centres, g.ratio, yerr=g.std, fmt="o-", ms=3, capsize=2,
+                            color=colour, label=f"{label}: {100 * g.change:+.1f} % ({g.z:.0f} σ)")
+        ax.axhline(1.0, color="k", linewidth=0.8)
+        ax.set_xlabel(f"{variable} [{VARIABLES[variable]}]")
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3)
+    along = axes[-1]
+    for g in (g for g in before if g.variable == "time in run"):
+        along.plot(g.centres, g.ratio, "o-", ms=3, label=g.run)
+    along.axhline(1.0, color="k", linewidth=0.8)
+    along.set_xlabel("time since braking started [s] (calibrated)")
+    along.legend(fontsize=6)
+    along.grid(alpha=0.3)
+    axes[0].set_ylabel("local k_b / model's k_b")
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def local_gain_section(before: Sequence[LocalGain], after: Sequence[LocalGain],
+                       folder: Path) -> tuple[str, str]:
+    figure = plot_local_gains(before, after, folder / "local_gains.png")
+    rows = [[model, g.variable, g.run, f"{100 * g.change:+.2f} %", f"{100 * g.change_std:.2g} %",
+             f"{g.z:.1f}"] for model, gains in (("calibrated", before), ("extended", after))
+            for g in gains]
+    table = html_table(["model", "against", "run", "change over range", "1σ", "z"], rows)
+    return ("Brake gain, re-estimated locally", html_image(figure, folder) + table)

@@ -48,7 +48,7 @@ class Case:
     """One cause: how to hide it, what to start without, its key parameter and tolerance."""
 
     draw: Draw
-    key: str
+    key: str | Callable[[RigParameters], str]  # a contract parameter (of the hidden rig)
     truth: Truth
     tolerance: float  # absolute if ``absolute`` else relative
     absolute: bool = False
@@ -96,6 +96,17 @@ CASES: dict[str, Case] = {
 }
 
 
+def _runout(rng: np.random.Generator, datasheet: RigParameters) -> dict:
+    """An encoder ripple once or twice per revolution (the generator gives each run a start
+    angle of its own)."""
+    key = f"sensors.wheel_runout_{rng.choice([1, 2])}"
+    return {key: rng.uniform(0.002, 0.02), f"{key}_phase_rad": rng.uniform(-np.pi, np.pi)}
+
+
+def _runout_order(rig: RigParameters) -> str:
+    return "wheel_runout_1" if rig.number("sensors.wheel_runout_1") else "wheel_runout_2"
+
+
 # effects outside the catalogue (issue 14): the generator's own laws, off by default; the
 # diagnosis must answer 'discovered' with this family, a held-out gain and the parameter
 FAMILIES: dict[str, Case] = {
@@ -117,6 +128,8 @@ FAMILIES: dict[str, Case] = {
     "run_drift": Case(
         lambda r, d: {"brake.gain_drift_per_run": r.choice([-1, 1]) * r.uniform(0.015, 0.04)},
         "gain_drift_per_run", _number("brake.gain_drift_per_run"), 0.2),
+    "wheel_angle": Case(_runout, _runout_order,
+                        lambda rig: rig.number(f"sensors.{_runout_order(rig)}"), 0.1),
     "input_history": Case(
         lambda r, d: {"actuator.backlash_a": r.uniform(0.004, 0.04)},
         "backlash_a", _number("actuator.backlash_a"), 0.2),
@@ -143,11 +156,15 @@ def run_case(cause: str | None, seed: int, datasheet: RigParameters) -> tuple[bo
             result.verdict == "discovered" else result.verdict
         if result.verdict != "discovered" or not found:
             return False, verdict, math.nan
-        return _within(case, found[0].parameters[case.key], rig, verdict)
+        return _within(case, found[0].parameters.get(_key(case, rig), math.nan), rig, verdict)
     found = [f for f in result.findings if f.cause == cause]
     if result.verdict != cause or not found:
         return False, result.verdict, math.nan
-    return _within(case, found[0].parameters[case.key], rig, result.verdict)
+    return _within(case, found[0].parameters[_key(case, rig)], rig, result.verdict)
+
+
+def _key(case: Case, rig: RigParameters) -> str:
+    return case.key if isinstance(case.key, str) else case.key(rig)
 
 
 def _within(case: Case, value: float, rig: RigParameters, verdict: str

@@ -17,6 +17,7 @@ from landing_gear_sim.diagnosis.consistency import (
     FREE_ROLLING,
     RUN_DRIFT,
     VALVE_DIRECTION,
+    WHEEL_ANGLE,
     check_campaign,
     violations,
 )
@@ -164,6 +165,29 @@ def test_a_brake_gain_drifting_through_the_campaign_is_discovered_as_run_drift(r
     generate_campaign(tmp_path, rig.replace({"brake.gain_drift_per_run": drift}, "wear"), 151)
     finding = _discovered_alone(diagnose(read_campaign(tmp_path).runs, reference), "run_drift")
     assert finding.parameters["gain_drift_per_run"] == pytest.approx(drift, rel=0.2)
+
+
+def test_an_encoder_rippling_with_the_wheel_angle_is_discovered_as_wheel_angle(reference,
+                                                                             tmp_path):
+    """A wheel encoder reading ω (1 + e cos(mθ + φ)) (the test draws the order, 1 or 2, the
+    size, 0.2-2 %, and the phase; each run starts at an angle of its own; the code under
+    test sees none of it) once got 'none': the ripple chirps with the speed and averages out
+    of everything the calibration fits. In free rolling, in the angle domain, it stands out;
+    fitted with each run's own phase it is the run-out, measured."""
+    rng = np.random.default_rng(161)
+    order = int(rng.choice([1, 2]))
+    size = rng.uniform(0.002, 0.02)
+    key = f"sensors.wheel_runout_{order}"
+    rig = rig_like(reference, rng).replace(
+        {key: size, f"{key}_phase_rad": rng.uniform(-np.pi, np.pi)}, "run-out")
+    generate_campaign(tmp_path, rig, 161, RUNS)
+    runs = read_campaign(tmp_path).runs
+    calibrated = identify(classify_all(runs), reference, jackknife=False).params
+    broken = {c.relation for c in violations(check_campaign(classify_all(runs), calibrated))}
+    assert WHEEL_ANGLE in broken
+    finding = _discovered_alone(diagnose(runs, reference), "wheel_angle")
+    assert set(finding.parameters) == {f"wheel_runout_{order}"}
+    assert finding.parameters[f"wheel_runout_{order}"] == pytest.approx(size, rel=0.05)
 
 
 def test_the_local_brake_gain_shows_a_law_in_speed_the_calibration_averaged(reference,

@@ -25,12 +25,16 @@ from msg_tools.io import read_run
 GAIN = "brake.gain_n_m_per_pa"
 
 
-@pytest.mark.parametrize("kind, delay_s", [("threshold", 0.0), ("slip", 0.0),
-                                           ("threshold", 2.5e-3)])
-def test_the_compiled_closed_loop_is_the_block_loop_to_the_last_bit(reference, kind, delay_s):
+@pytest.mark.parametrize("kind, delay_s, runout", [("threshold", 0.0, 0.0), ("slip", 0.0, 0.0),
+                                                   ("threshold", 2.5e-3, 0.0),
+                                                   ("slip", 2.5e-3, 0.01)])
+def test_the_compiled_closed_loop_is_the_block_loop_to_the_last_bit(reference, kind, delay_s,
+                                                                    runout):
     """What the graph steps (blocks) and what Monte Carlo runs (one compiled loop) agree,
-    the wheel channel read out of step included."""
-    rig = with_surface(reference, "wet").replace({"sensors.wheel_speed_delay_s": delay_s})
+    the wheel channel read out of step and rippling with the wheel's angle included."""
+    rig = with_surface(reference, "wet").replace({
+        "sensors.wheel_speed_delay_s": delay_s, "sensors.wheel_runout_1": runout,
+        "sensors.wheel_runout_1_phase_rad": 0.7, "sensors.wheel_runout_2": runout / 2})
     blocks = closed_loop(rig, make_controller(kind, rig, 1e-3))
     compiled = compiled_closed_loop(rig, kind)
     assert compiled.stop_reason == blocks.stop_reason == "stop speed reached"

@@ -235,18 +235,46 @@ def test_a_wheel_channel_out_of_step_reads_the_same_offline_and_in_the_node(refe
                                                                            run_30bar):
     """sensors.wheel_speed_delay_s: the wheel channel reads ω(t − d), the same value from the
     plant node's recent samples as from the whole offline run."""
-    from landing_gear_sim.model.blocks import PlantBlock
-
     late = reference.replace({"sensors.wheel_speed_delay_s": 0.0205}, "test")
     offline = simulate(late, run_30bar.scenario).to_run()
     truth = run_30bar.wheel_speed_rad_s
     assert np.allclose(offline.wheel_speed_rad_s[:21], truth[0])
     assert np.allclose(offline.wheel_speed_rad_s[100:],
                        0.5 * (truth[79:-21] + truth[80:-20]))
-    block = PlantBlock(late, run_30bar.scenario)
+    assert np.array_equal(_node_wheel_readings(late, run_30bar, 3000),
+                          offline.wheel_speed_rad_s[:3000])
+
+
+def _node_wheel_readings(params, run, samples: int) -> list[float]:
+    """The plant node's wheel channel over the first ``samples`` of ``run``'s inputs."""
+    from landing_gear_sim.model.blocks import PlantBlock
+
+    block = PlantBlock(params, run.scenario)
     readings = []
-    for _ in range(3000):
+    for _ in range(samples):
         readings.append(block.sample().wheel_speed_rad_s)
-        block.advance(run_30bar.pressure_pa[block.step_index + 1],
-                      run_30bar.vertical_load_n[block.step_index + 1])
-    assert np.array_equal(readings, offline.wheel_speed_rad_s[:3000])
+        block.advance(run.pressure_pa[block.step_index + 1],
+                      run.vertical_load_n[block.step_index + 1])
+    return readings
+
+
+def test_a_wheel_encoder_with_run_out_ripples_with_the_angle_the_same_offline_and_in_the_node(
+        reference, run_30bar):
+    """sensors.wheel_runout_*: the encoder reads ω (1 + e₁ cos(θ + φ₁) + e₂ cos(2θ + φ₂)), θ
+    the wheel's angle since the first sample; the plant node, reading sample by sample (and
+    out of step), gives what the whole offline run gives."""
+    from scipy.integrate import cumulative_trapezoid
+
+    wobbly = reference.replace({"sensors.wheel_runout_1": 0.01,
+                                "sensors.wheel_runout_1_phase_rad": 0.7,
+                                "sensors.wheel_runout_2": 0.004,
+                                "sensors.wheel_runout_2_phase_rad": -2.0}, "test")
+    offline = simulate(wobbly, run_30bar.scenario).to_run()
+    truth = run_30bar.wheel_speed_rad_s
+    angle = cumulative_trapezoid(truth, run_30bar.time_s, initial=0.0)
+    expected = truth * (1 + 0.01 * np.cos(angle + 0.7) + 0.004 * np.cos(2 * angle - 2.0))
+    np.testing.assert_allclose(offline.wheel_speed_rad_s, expected, rtol=1e-9)
+    late = wobbly.replace({"sensors.wheel_speed_delay_s": 0.0205}, "test")
+    offline_late = simulate(late, run_30bar.scenario).to_run()
+    np.testing.assert_array_equal(_node_wheel_readings(late, run_30bar, 3000),
+                                  offline_late.wheel_speed_rad_s[:3000])

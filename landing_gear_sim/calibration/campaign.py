@@ -17,6 +17,7 @@ from landing_gear_sim.calibration.measured import run_parameters
 from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.sensors import RUNOUT_KEYS, SensorModel
 from msg_tools.csv_io import write_csv
 from msg_tools.units import PA_PER_BAR
 
@@ -60,6 +61,18 @@ def _campaign_order(braking: Sequence[str]) -> dict[str, float]:
     return {name: rank - (len(ordered) - 1) / 2 for rank, name in enumerate(ordered)}
 
 
+def _start_angle(params: RigParameters, rng: np.random.Generator) -> RigParameters:
+    """A run starts with the wheel at an angle of its own: an encoder's ripple with the
+    angle (run-out) has a phase of its own in each run."""
+    sensors = SensorModel.of(params)
+    if not sensors.ripples:
+        return params
+    start = rng.uniform(0.0, 2.0 * np.pi)
+    _, phase1, _, phase2 = sensors.runout
+    return params.replace({RUNOUT_KEYS[1]: phase1 + start, RUNOUT_KEYS[3]: phase2 + 2 * start},
+                          "the run's start angle")
+
+
 def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,
                       names: Sequence[str] | None = None) -> list[Path]:
     """Simulate and write the standard runs of ``rig`` (or those in ``names``) into
@@ -73,7 +86,8 @@ def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,
     for i, (name, scenario) in enumerate(scenarios.items()):
         if names is not None and name not in names:
             continue
-        params = run_parameters(rig, order.get(name, 0.0))
+        params = _start_angle(run_parameters(rig, order.get(name, 0.0)),
+                              np.random.default_rng([seed, i]))
         run = simulate(params, scenario).to_run(noise=seed * 100 + i)
         path = folder / f"{name}.csv"
         write_csv(run, path)

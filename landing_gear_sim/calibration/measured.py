@@ -13,10 +13,12 @@ from collections.abc import Sequence
 import numpy as np
 
 from landing_gear_sim.calibration.runs import ClassifiedRun, classified
+from landing_gear_sim.calibration.wheel_angle import measured_angle_rad, run_phases
 from landing_gear_sim.model.integrate import SimulationResult, simulate
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s
 from landing_gear_sim.model.scenario import Scenario, logged_to_held
+from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.run import Run
 
 CHANNELS: dict[str, str] = {
@@ -69,12 +71,18 @@ def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult
     If the model stops (speed below 1 m/s) before the measurement ends, the last
     simulated sample is held, so both have the same length, except the pressure: the
     valve goes on following the measured current. The touch-down time is the run's
-    start, as in the rig procedure.
+    start, as in the rig procedure. A wheel encoder that ripples with the wheel's angle
+    ripples at the measured angle, with the run's own phase (see
+    :mod:`~landing_gear_sim.calibration.wheel_angle`).
     """
     run = classified(run)
     params = run_parameters(params, run.campaign_order)
+    angle = None
+    if run.braking and SensorModel.of(params).ripples:
+        params, angle = run_phases(params, run), measured_angle_rad(run)
     result = simulate(params, scenario_for_run(run, params))
-    simulated = result.to_run()
+    simulated = result.to_run(
+        wheel_angle_rad=None if angle is None else angle[:len(result.time_s)])
     n, m = len(run), len(simulated)
     take = np.minimum(np.arange(n), m - 1)
     fields = {name: getattr(simulated, name)[take] for name in CHANNELS}

@@ -10,6 +10,8 @@ curve, the brake gain or the drag to swallow an effect the relations still show)
 * no contact (actuator-only runs) ⇒ zero loads;
 * the valve's pressure against the model's, where the current changes slowly, does not
   depend on whether the current last rose or fell (play, hysteresis: ``input_history``);
+* in free rolling the wheel channel is smooth in the wheel's angle: no ripple once or twice
+  per revolution beyond the model's (run-out, an out-of-round code wheel: ``wheel_angle``);
 * the brake gain of the wheel's torque balance r F_x − J_w ω̇ = k_b P does not depend on
   the speed or on the pressure level (a local k_b, fitted with a linear trend), nor on the
   run (k_b of each run, in the campaign's run order: wear, a brake that beds in).
@@ -34,6 +36,7 @@ from landing_gear_sim.calibration.statistics import (
     linear_std,
     weighted_least_squares,
 )
+from landing_gear_sim.calibration.wheel_angle import ORDERS, angle_ripple
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.scoring import effective_count
 from landing_gear_sim.model.actuator import actuator_pressure
@@ -55,6 +58,8 @@ GAIN_IN_SPEED = "brake gain constant in speed"
 GAIN_IN_PRESSURE = "brake gain linear in pressure"
 RUN_DRIFT = "brake gain constant from run to run"
 VALVE_DIRECTION = "valve the same with the current rising and falling"
+WHEEL_ANGLE = "wheel channel smooth in the wheel's angle"
+RUNOUT_FLOOR = 1e-3  # a ripple below 0.1 % of the wheel speed is within the encoder's noise
 SLOW_A_S = 0.5  # slower current changes: A(s) errors leave no direction-locked residual
 
 
@@ -122,7 +127,7 @@ def _run_checks(run: ClassifiedRun, prepared: br.Braking | None, params: RigPara
     """The checks of one run (``prepared``: its filtered signals, for a braking run)."""
     checks = [_zero_current(run, params)]
     if prepared is not None:
-        checks.append(_free_rolling(prepared, params))
+        checks.extend([_free_rolling(prepared, params), _wheel_angle(run, params)])
     else:
         checks.extend(_mean_check("no contact ⇒ no load", run.name, "whole run",
                                   getattr(run, name), FORCE_FLOOR_N, "N", label)
@@ -154,6 +159,19 @@ def _valve_direction(run: ClassifiedRun, params: RigParameters) -> Check | None:
                         for r in (falling, rising)))
     return Check(VALVE_DIRECTION, run.name, "slow current changes",
                  float(falling.mean() - rising.mean()), std, PRESSURE_FLOOR_PA, "Pa")
+
+
+def _wheel_angle(run: ClassifiedRun, params: RigParameters) -> Check | None:
+    """The wheel channel's strongest ripple with the wheel's angle in free rolling, beyond
+    the model's own run-out of that order [relative to ω]."""
+    ripple = angle_ripple(run)
+    if ripple is None:
+        return None
+    runout = SensorModel.of(params).runout
+    checks = [Check(WHEEL_ANGLE, run.name, f"before braking, {m}× per revolution",
+                    ripple.amplitude[i] - runout[2 * i], ripple.std[i], RUNOUT_FLOOR, "of ω")
+              for i, m in enumerate(ORDERS)]
+    return max(checks, key=lambda c: c.z)
 
 
 def _mean_check(relation: str, run: str, phase: str, values: np.ndarray, floor: float,

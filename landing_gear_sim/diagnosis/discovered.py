@@ -23,6 +23,7 @@ from landing_gear_sim.diagnosis.consistency import (
     GAIN_IN_SPEED,
     RUN_DRIFT,
     VALVE_DIRECTION,
+    WHEEL_ANGLE,
     Check,
     check_campaign,
     violations,
@@ -33,8 +34,10 @@ from landing_gear_sim.diagnosis.discovery import (
     discovered_candidate,
     drift_candidate,
     families,
+    runout_candidate,
     select_brake_terms,
     select_channel_terms,
+    select_runout_orders,
     skew_candidate,
     term_formula,
 )
@@ -57,6 +60,11 @@ def discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: Rig
     if excess and max(excess) > 0:  # the valve first: what it misreads reaches every run
         scored = _score_discovered(backlash_candidate(max(excess), model), runs, model,
                                    datasheet, scales, signatures, say)
+    if WHEEL_ANGLE in broken and (scored is None or not scored.finding.accepted):
+        orders = select_runout_orders(runs)
+        if orders:
+            scored = _score_discovered(runout_candidate(orders), runs, model, datasheet,
+                                       scales, signatures, say)
     lags = [s.value for s in signatures if s.kind is SignatureKind.LAG
             and s.channel == "wheel_speed_rad_s" and s.value > 0]
     if lags and (scored is None or not scored.finding.accepted):

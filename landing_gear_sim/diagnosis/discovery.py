@@ -1,5 +1,5 @@
 """Discovery of terms the catalogue lacks (issue 14, part 3: brake torque, load-cell channels,
-the wheel channel's timing, the valve's play).
+the wheel channel's timing and its ripple with the wheel's angle, the valve's play).
 
 When the brake-gain consistency checks are violated, the wheel's torque balance
 r F_x − J_w ω̇ = k_b P (1 + Σ c_i x_i) is regressed on a library of physical terms x_i
@@ -21,9 +21,11 @@ from dataclasses import dataclass
 from typing import TypeVar
 
 import numpy as np
+import scipy.linalg
 
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.calibration.wheel_angle import ORDERS, TREND, ripple_design
 from landing_gear_sim.diagnosis.catalogue import (
     ACTUATOR_RUNS,
     BRAKE_RUNS,
@@ -33,13 +35,19 @@ from landing_gear_sim.diagnosis.catalogue import (
     WHEEL,
     Candidate,
 )
-from landing_gear_sim.diagnosis.consistency import FORCE_FLOOR_N, free_rolling_excess
+from landing_gear_sim.diagnosis.consistency import (
+    FORCE_FLOOR_N,
+    RUNOUT_FLOOR,
+    free_rolling_excess,
+)
 from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.sensors import RUNOUT_KEYS
 from msg_tools.units import PA_PER_BAR
 
 DISCOVERED = "discovered"
 DECIMATE = 100  # samples: the balance's residual is smooth; BIC must not count it 100x
 MIN_RELATIVE_EFFECT = 0.02  # a term changing the gain by less over its range is dropped
+RUNOUT_DECIMATE = 3  # samples: keeps a twice-per-revolution ripple at 60 m/s (62 Hz) resolved
 
 
 @dataclass(frozen=True)
@@ -194,6 +202,39 @@ def drift_candidate(change: float, braking_runs: int) -> Candidate:
                      (("gain_drift_per_run", DRIFT_KEY),))
 
 
+RUNOUT_BOUNDS = (0.0, 0.1)  # relative: a tenth of ω at most
+
+
+def select_runout_orders(runs: Sequence[ClassifiedRun]) -> dict[str, float]:
+    """The orders of the wheel channel's ripple with the wheel's angle that the free rolling
+    of ``runs`` needs (sparse regression on cos(mθ), sin(mθ) of each run: a run has a phase
+    of its own), with the median amplitude over the runs: ``sensors.wheel_runout_m`` ->
+    relative amplitude, kept above the consistency floor."""
+    fitted = [f for f in (ripple_design(r) for r in runs if r.braking) if f is not None]
+    if not fitted:
+        return {}
+    detrended, waves = [], []
+    for y, design in fitted:
+        trend = design[:, :TREND]
+        coef, *_ = np.linalg.lstsq(trend, y, rcond=None)
+        detrended.append((y - trend @ coef)[::RUNOUT_DECIMATE])
+        waves.append(design[::RUNOUT_DECIMATE, TREND:])
+    coef = sparse_coefficients(scipy.linalg.block_diag(*waves), np.concatenate(detrended))
+    pairs = coef.reshape(len(fitted), len(ORDERS), 2)
+    amplitude = np.median(np.hypot(pairs[..., 0], pairs[..., 1]), axis=0)
+    return {RUNOUT_KEYS[2 * i]: float(a) for i, a in enumerate(amplitude) if a > RUNOUT_FLOOR}
+
+
+def runout_candidate(orders: dict[str, float]) -> Candidate:
+    """The wheel encoder rippling once or twice per revolution (``wheel_angle``) at the kept
+    orders, each run at its own phase: fitted alone on the braking runs' wheel channel (the
+    ripple averages out of everything the calibration fitted)."""
+    keys = tuple(orders)
+    return Candidate(DISCOVERED, None, keys, (tuple(orders.values()),),
+                     tuple(RUNOUT_BOUNDS for _ in keys), (), BRAKE_RUNS,
+                     ("wheel_speed_rad_s",), (), tuple((k.split(".")[1], k) for k in keys))
+
+
 def discovered_candidate(terms: dict[LibraryTerm, float]) -> Candidate:
     """The kept brake terms as a candidate, fitted with k_b and the friction curve."""
     return _term_candidate(terms, ("brake.gain_n_m_per_pa", *FRICTION), WHEEL)
@@ -211,6 +252,8 @@ def _term_candidate(terms: Mapping[TermT, float], free: tuple[str, ...],
 
 
 def families(candidate: Candidate) -> str:
+    if set(candidate.keys) & set(RUNOUT_KEYS):
+        return "wheel_angle"
     if SKEW_KEY in candidate.keys:
         return "channel_skew"
     if BACKLASH_KEY in candidate.keys:
@@ -224,6 +267,10 @@ def families(candidate: Candidate) -> str:
 def term_formula(candidate: Candidate, params: RigParameters) -> str:
     """The extended law with its fitted values, e.g. ``T_b = k_b·P·(1 − 6.4e-04·ω)`` or
     ``F_x,read = F_x + 0.0123·F_z``."""
+    if set(candidate.keys) & set(RUNOUT_KEYS):
+        waves = [f"{100 * params.number(k):.2f} %·cos({m}θ + φ{m})" for m, k in
+                 zip(ORDERS, RUNOUT_KEYS[::2], strict=True) if k in candidate.keys]
+        return f"ω_read = ω·(1 + {' + '.join(waves)}), θ: wheel angle, φ: each run's own"
     if SKEW_KEY in candidate.keys:
         return f"ω_read(t) = ω(t − {1e3 * params.number(SKEW_KEY):.1f} ms)"
     if BACKLASH_KEY in candidate.keys:

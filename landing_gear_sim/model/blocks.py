@@ -90,6 +90,7 @@ class PlantBlock:
         # the wheel channel out of step reads this many recent samples (none when in step)
         kept = math.ceil(self._sensors.wheel_delay_s / scenario.step_s) + 2
         self._wheel_history: deque[tuple[float, float]] = deque(maxlen=max(kept, 1))
+        self._wheel_angle = (0.0, 0.0, 0.0)  # time [s], speed [rad/s], angle [rad] last read
         self.step_index = 0
         self.pressure_pa = 0.0
         self.load_n = 0.0
@@ -130,12 +131,24 @@ class PlantBlock:
 
     def _wheel_read(self, time_s: float, wheel_rad_s: float) -> float:
         """The wheel channel's noise-free reading now (out of step: from recent samples)."""
+        if self._sensors.ripples:
+            wheel_rad_s = self._encoder(time_s, wheel_rad_s)
         if self._sensors.wheel_delay_s <= 0.0:
             return wheel_rad_s
         if not self._wheel_history or self._wheel_history[-1][0] < time_s:
             self._wheel_history.append((time_s, wheel_rad_s))
         times, wheel = (np.array(column) for column in zip(*self._wheel_history, strict=True))
         return float(self._sensors.out_of_step(times, wheel)[-1])
+
+    def _encoder(self, time_s: float, wheel_rad_s: float) -> float:
+        """The encoder's reading at the wheel's angle, advanced by the trapezoid from the
+        last sample read (the increments :func:`~landing_gear_sim.model.sensors.wheel_angle_rad`
+        sums offline)."""
+        last_s, last_rad_s, angle = self._wheel_angle
+        if time_s > last_s:
+            angle += 0.5 * (wheel_rad_s + last_rad_s) * (time_s - last_s)
+        self._wheel_angle = (time_s, wheel_rad_s, angle)
+        return float(self._sensors.encoder(wheel_rad_s, angle))
 
     def advance(self, next_pressure_pa: float, next_load_n: float) -> None:
         """Integrate to the next sample with inputs ramping to the given end values."""

@@ -109,12 +109,15 @@ class SimulationResult:
                         self.scenario.current_a, pressure)
         return SensorModel.of(self.params).pressure(pressure)
 
-    def to_run(self, noise: np.random.Generator | int | None = None) -> Run:
+    def to_run(self, noise: np.random.Generator | int | None = None,
+               wheel_angle_rad: np.ndarray | None = None) -> Run:
         """The run as the rig's sensors would log it (data contract).
 
         The sensors are those of :class:`~landing_gear_sim.model.sensors.SensorModel`:
         the pressure offset when its element is on, and the ``sensors.*`` noise only when
-        ``noise`` (a generator, or a seed for a reproducible one) is given.
+        ``noise`` (a generator, or a seed for a reproducible one) is given. The wheel
+        encoder ripples at ``wheel_angle_rad`` (one per sample; default: the simulated
+        wheel's own angle).
         """
         rng = None if noise is None else np.random.default_rng(noise)
         sensors = SensorModel.of(self.params)
@@ -122,7 +125,8 @@ class SimulationResult:
             name=self.scenario.name, source="simulation", time_s=self.time_s.copy(),
             current_a=held_to_logged(self.current_a),
             pressure_pa=sensors.pressure(self.pressure_pa, rng),
-            wheel_speed_rad_s=sensors.wheel_speed(self.time_s, self.wheel_speed_rad_s, rng),
+            wheel_speed_rad_s=sensors.wheel_speed(self.time_s, self.wheel_speed_rad_s, rng,
+                                                  wheel_angle_rad),
             flywheel_speed_rad_s=sensors.speed(flywheel_speed_rad_s(self.params, self.speed_m_s),
                                                rng),
             vertical_load_n=sensors.force(self.vertical_load_n, rng),

@@ -138,6 +138,15 @@ SPECS: tuple[ParamSpec, ...] = (
               "relative change of k_b from one braking run of a campaign to the next, in run "
               "order, about the middle run (wear; a campaign-level term: a run simulated on "
               "its own has the middle run's k_b; 0: none)", signed=True, default=0.0),
+    *(spec for order in (1, 2) for spec in (
+        ParamSpec(f"sensors.wheel_runout_{order}", "-",
+                  f"the wheel encoder reads omega (1 + e cos({order} theta + phi)): a ripple "
+                  f"{order}x per wheel revolution, relative (run-out, an out-of-round code "
+                  "wheel; 0: none)", default=0.0),
+        ParamSpec(f"sensors.wheel_runout_{order}_phase_rad", "rad",
+                  "phase phi of that ripple at the run's first sample (theta = 0 there; a "
+                  "measured run's own is read from its wheel channel)", signed=True,
+                  default=0.0))),
 )
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}

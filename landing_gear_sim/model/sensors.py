@@ -5,7 +5,9 @@ Pressure transducer: the true gauge pressure plus ``sensors.pressure_offset_pa``
 the true value plus white noise; the load cell's longitudinal channel also reads
 ``sensors.crosstalk_fx_per_fz`` of the vertical load (0 on a clean channel), and the wheel
 encoder's channel may be ``sensors.wheel_speed_delay_s`` out of step with the others (it
-reads the wheel speed that much earlier, linearly interpolated; 0: in step). Noise is
+reads the wheel speed that much earlier, linearly interpolated; 0: in step) and may ripple
+once and twice per wheel revolution (``sensors.wheel_runout_*``: ω (1 + e cos(mθ + φ)), θ the
+wheel angle since the run's first sample, the trapezoid integral of the sampled ω). Noise is
 drawn only when a random generator is given (``sensors.*_noise_*`` std; 0 means none), so a
 simulation compared with a measurement is never noisy by accident. Values are floats or
 arrays alike.
@@ -32,6 +34,7 @@ class SensorModel:
     force_noise_n: float = 0.0
     fx_per_fz: float = 0.0
     wheel_delay_s: float = 0.0
+    runout: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0)  # e₁, φ₁ [rad], e₂, φ₂ [rad]
 
     @classmethod
     def of(cls, params: RigParameters) -> SensorModel:
@@ -41,7 +44,13 @@ class SensorModel:
                    params.number("sensors.speed_noise_rad_s"),
                    params.number("sensors.force_noise_n"),
                    params.number("sensors.crosstalk_fx_per_fz"),
-                   params.number("sensors.wheel_speed_delay_s"))
+                   params.number("sensors.wheel_speed_delay_s"),
+                   tuple(params.number(k) for k in RUNOUT_KEYS))
+
+    @property
+    def ripples(self) -> bool:
+        """Whether the wheel encoder ripples with the wheel's angle."""
+        return self.runout[0] != 0.0 or self.runout[2] != 0.0
 
     def pressure(self, true_pa: Value, rng: np.random.Generator | None = None) -> Value:
         """Transducer reading [Pa, gauge] of the true brake pressure."""
@@ -56,10 +65,22 @@ class SensorModel:
         return _noisy(true_n, self.force_noise_n, rng)
 
     def wheel_speed(self, times_s: np.ndarray, true_rad_s: np.ndarray,
-                    rng: np.random.Generator | None = None) -> np.ndarray:
+                    rng: np.random.Generator | None = None,
+                    angle_rad: np.ndarray | None = None) -> np.ndarray:
         """Wheel-encoder channel [rad/s] of the samples at ``times_s`` (s, increasing; shape
-        of ``true_rad_s``)."""
-        return _noisy(self.out_of_step(times_s, true_rad_s), self.speed_noise_rad_s, rng)
+        of ``true_rad_s``), at the wheel angles ``angle_rad`` (default: the integral of
+        ``true_rad_s``; a simulation of a measured run passes the measured angle)."""
+        if angle_rad is None and self.ripples:
+            angle_rad = wheel_angle_rad(times_s, true_rad_s)
+        encoder = true_rad_s if angle_rad is None else self.encoder(true_rad_s, angle_rad)
+        return _noisy(self.out_of_step(times_s, encoder), self.speed_noise_rad_s, rng)
+
+    def encoder(self, true_rad_s: Value, angle_rad: Value) -> Value:
+        """What the encoder reads of ``true_rad_s`` at the wheel angle ``angle_rad`` [rad/s]:
+        its ripple once and twice per revolution, no delay, no noise."""
+        e1, phase1, e2, phase2 = self.runout
+        return true_rad_s * (1.0 + e1 * np.cos(angle_rad + phase1)
+                             + e2 * np.cos(2.0 * angle_rad + phase2))
 
     def out_of_step(self, times_s: np.ndarray, true_rad_s: np.ndarray) -> np.ndarray:
         """The wheel speed ``wheel_delay_s`` before each of ``times_s`` (the first sample's
@@ -81,6 +102,17 @@ class SensorModel:
     def true_pressure(self, reading_pa: Value) -> Value:
         """The brake pressure behind a transducer reading (the offset removed) [Pa]."""
         return reading_pa - self.pressure_offset_pa
+
+
+RUNOUT_KEYS = ("sensors.wheel_runout_1", "sensors.wheel_runout_1_phase_rad",
+               "sensors.wheel_runout_2", "sensors.wheel_runout_2_phase_rad")
+
+
+def wheel_angle_rad(times_s: np.ndarray, speed_rad_s: np.ndarray) -> np.ndarray:
+    """The wheel angle since the first sample [rad]: the trapezoid integral of the sampled
+    speed, summed in sample order (the plant block adds the same increments one by one)."""
+    steps = 0.5 * (speed_rad_s[1:] + speed_rad_s[:-1]) * np.diff(times_s)
+    return np.concatenate([[0.0], np.cumsum(steps)])
 
 
 def _noisy(value: Value, std: float, rng: np.random.Generator | None) -> Value:

@@ -80,6 +80,8 @@ def test_load_cell_crosstalk_the_calibration_swallows_is_discovered_and_measured
     assert finding.fit_after["longitudinal_force_n"] > finding.fit_before["longitudinal_force_n"]
     assert not {c.cause for c in result.candidates if c.accepted} & set(CATALOGUE)
     assert violations(result.consistency) == []
+    assert FREE_ROLLING in {c.relation for c in violations(result.consistency_calibrated)}
+    assert finding.evidence.startswith(f"called for by {FREE_ROLLING}")
 
 
 @pytest.mark.parametrize(("family", "key", "scale"), [
@@ -186,6 +188,7 @@ def test_an_encoder_rippling_with_the_wheel_angle_is_discovered_as_wheel_angle(r
     broken = {c.relation for c in violations(check_campaign(classify_all(runs), calibrated))}
     assert WHEEL_ANGLE in broken
     finding = _discovered_alone(diagnose(runs, reference), "wheel_angle")
+    assert finding.evidence.startswith(f"called for by {WHEEL_ANGLE}")
     assert set(finding.parameters) == {f"wheel_runout_{order}"}
     assert finding.parameters[f"wheel_runout_{order}"] == pytest.approx(size, rel=0.05)
 

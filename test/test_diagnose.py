@@ -196,7 +196,9 @@ def test_cli_writes_the_contract_json_and_the_report(reference, tmp_path, capsys
             "delta_bic"} <= set(finding)
     assert finding["fit_after"]["pressure_pa"] > finding["fit_before"]["pressure_pa"]
     assert set(document["baseline"]) >= {"pressure_pa", "wheel_speed_rad_s"}
-    assert (tmp_path / "report" / "index.html").exists()
+    assert len(document["consistency_calibrated"]) == len(document["consistency"]) > 0
+    page = (tmp_path / "report" / "index.html").read_text()
+    assert "calibrated model" in page and "extended model" in page
     assert "VERDICT: actuator_delay" in capsys.readouterr().out
     assert main(["params", "--config", str(tmp_path / "extended.yaml")]) == 0
 

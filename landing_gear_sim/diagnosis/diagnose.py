@@ -82,6 +82,8 @@ class Diagnosis:
     """Per run: the simulations compared and the residual spectrum (for the report)."""
     consistency: list[Check] = field(default_factory=list)
     """The relations the rig measures twice, checked under the extended model."""
+    consistency_calibrated: list[Check] = field(default_factory=list)
+    """The same under the calibrated starting model: what called for an extension."""
     estimates: tuple[Estimate, ...] = ()
     """The starting model's calibration on the campaign: value and 1-σ per parameter."""
     local_before: list[LocalGain] = field(default_factory=list)
@@ -96,6 +98,7 @@ class Diagnosis:
                 "signatures_before": [s.describe() for s in self.signatures_before],
                 "signatures_after": [s.describe() for s in self.signatures_after],
                 "consistency": [c.to_json() for c in self.consistency],
+                "consistency_calibrated": [c.to_json() for c in self.consistency_calibrated],
                 "local_gains": {"calibrated": [g.to_json() for g in self.local_before],
                                 "extended": [g.to_json() for g in self.local_after]},
                 "problems": self.problems}
@@ -176,6 +179,7 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
                    if s is not best and (s.finding.delta_bic or 0.0) < 0]
     say("checking the relations the rig measures twice")
     checks = check_campaign(runs, model)
+    calibrated_checks = checks if model is calibrated else check_campaign(runs, calibrated)
     if not accepted:
         found = discovered.discover(runs, model, base, scales, before, checks, say)
         if found is not None:
@@ -205,8 +209,9 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     evidence = [run_evidence(*sims, calibrated)
                 for sims in zip(runs, simulated_before, simulated_after, strict=True)]
     return Diagnosis(verdict, findings, table, baseline, start, calibrated, model,
-                     before, after, problems, evidence, checks, calibration.estimates,
-                     local_gains(runs, calibrated), local_gains(runs, model))
+                     before, after, problems, evidence, checks, calibrated_checks,
+                     calibration.estimates, local_gains(runs, calibrated),
+                     local_gains(runs, model))
 
 
 def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],

@@ -82,7 +82,27 @@ def discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: Rig
         for candidate in _gain_candidates(runs, braking, model, checks):
             scored = _better(scored, _score_discovered(candidate, runs, model, datasheet,
                                                        scales, signatures, say))
-    return scored
+    return None if scored is None else _called_for(scored, checks)
+
+
+CALLED_FOR = {"input_history": (VALVE_DIRECTION,), "wheel_angle": (WHEEL_ANGLE,),
+              "channel_crosstalk": (FREE_ROLLING,), "run_drift": (RUN_DRIFT,)}
+"""The relations whose violation calls for each family (the brake-gain laws: their own)."""
+
+
+def _called_for(scored: Scored, checks: Sequence[Check]) -> Scored:
+    """The finding's evidence led by what called for it: the violated relations of its
+    family (up to two), or for a skew the wheel channel's lag."""
+    family = scored.finding.family
+    relations = CALLED_FOR.get(family, (GAIN_IN_SPEED, GAIN_IN_PRESSURE))
+    broken = [c.describe() for c in violations(checks) if c.relation in relations][:2]
+    reason = ("the wheel channel lags the model's consistently (residual signature)"
+              if family == "channel_skew" else "; ".join(broken))
+    if not reason:
+        return scored
+    finding = replace(scored.finding, evidence=f"called for by {reason}; "
+                      + scored.finding.evidence)
+    return Scored(finding, scored.fit)
 
 
 def _gain_candidates(runs: Sequence[ClassifiedRun], braking: Sequence[br.Braking],

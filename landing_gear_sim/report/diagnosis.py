@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import matplotlib.pyplot as plt
+import matplotlib.ticker
 import numpy as np
 
 from landing_gear_sim.calibration.measured import CHANNELS
@@ -113,7 +114,8 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
                     [["calibrated starting model", s.describe()] for s in result.signatures_before]
                     + [["extended model", s.describe()] for s in result.signatures_after]))]
     if result.consistency:
-        sections.append(_consistency_section(result.consistency, folder))
+        sections.append(_consistency_section(result.consistency_calibrated,
+                                             result.consistency, folder))
     if result.local_before or result.local_after:
         sections.append(local_gain_section(result.local_before, result.local_after, folder))
     for item in result.evidence:
@@ -133,32 +135,61 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
     return sections
 
 
-def _consistency_section(checks: Sequence[Check], folder: Path) -> tuple[str, str]:
-    table = html_table(["relation", "run", "phase", "deviation", "1σ", "floor", "violated"],
-                       [[c.relation, c.run, c.phase, f"{c.deviation:+.4g} {c.unit}",
-                         f"{c.std:.2g}", f"{c.floor:.2g}", "YES" if c.violated else "no"]
-                        for c in checks])
-    figure = plot_consistency(checks, folder / "consistency.png")
+def _consistency_section(calibrated: Sequence[Check], extended: Sequence[Check],
+                         folder: Path) -> tuple[str, str]:
+    pairs = paired_checks(calibrated, extended)
+    table = html_table(["relation", "run", "calibrated model", "extended model", "floor"],
+                       [[after.relation, after.run, _check_cell(before), _check_cell(after),
+                         f"{after.floor:.2g} {after.unit}"] for before, after in pairs])
+    figure = plot_consistency(pairs, folder / "consistency.png")
     return ("Consistency of what the rig measures twice", html_image(figure, folder) + table)
 
 
-def plot_consistency(checks: Sequence[Check], path: Path) -> Path:
-    """Each check's deviation in σ (log scale) against the violation threshold; a check
-    whose deviation is also under its physical floor is drawn grey."""
-    labels = [f"{c.relation} — {c.run}" for c in checks]
-    sigmas = [max(min(c.z, 1e4), 1e-2) for c in checks]
-    colours = ["tab:red" if c.violated else ("tab:orange" if c.z > Z_VIOLATED else "tab:grey")
-               for c in checks]
-    fig, ax = plt.subplots(figsize=(9, 0.3 * len(checks) + 1.2))
-    ax.barh(range(len(checks)), sigmas, color=colours)
+def paired_checks(calibrated: Sequence[Check], extended: Sequence[Check]
+                  ) -> list[tuple[Check | None, Check]]:
+    """Each check of the extended model with the same relation on the same run under the
+    calibrated model (None where that one was not made)."""
+    first = {(c.relation, c.run): c for c in calibrated}
+    return [(first.get((c.relation, c.run)), c) for c in extended]
+
+
+def _check_cell(check: Check | None) -> str:
+    if check is None:
+        return "-"
+    return (f"{check.deviation:+.4g} ± {check.std:.2g} {check.unit} ({check.phase})"
+            + (" VIOLATED" if check.violated else ""))
+
+
+def plot_consistency(pairs: Sequence[tuple[Check | None, Check]], path: Path) -> Path:
+    """Each check's deviation in σ (log scale) under the calibrated model (pale) and the
+    extended one, against the violation threshold; red: violated, orange: over the
+    threshold but under its physical floor."""
+    fig, ax = plt.subplots(figsize=(9, 0.4 * len(pairs) + 1.4))
+    rows = np.arange(len(pairs))
+    for offset, alpha, label, index in ((-0.2, 0.4, "calibrated model", 0),
+                                        (0.2, 1.0, "extended model", 1)):
+        checks = [pair[index] for pair in pairs]
+        ax.barh(rows + offset, [_sigmas(c) for c in checks], height=0.4, alpha=alpha,
+                color=[_colour(c) for c in checks], label=label)
     ax.axvline(Z_VIOLATED, color="k", linestyle="--", label=f"{Z_VIOLATED:g} σ")
     ax.set_xscale("log")
-    ax.set_yticks(range(len(checks)), labels, fontsize=7)
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    ax.set_yticks(rows, [f"{after.relation} — {after.run}" for _, after in pairs], fontsize=7)
     ax.invert_yaxis()
     ax.set_xlabel("|deviation| / σ (red: violated; orange: over σ but under its physical floor)")
-    ax.legend(loc="lower right")
+    ax.legend(loc="lower right", fontsize=7)
     fig.tight_layout()
     return save_figure(fig, path)
+
+
+def _sigmas(check: Check | None) -> float:
+    return 0.0 if check is None else max(min(check.z, 1e4), 1e-2)
+
+
+def _colour(check: Check | None) -> str:
+    if check is None or not check.z > Z_VIOLATED:
+        return "tab:grey"
+    return "tab:red" if check.violated else "tab:orange"
 
 
 def _text(value: float | None) -> str:
@@ -188,9 +219,11 @@ def diagnosis_summary(result: Diagnosis) -> str:
                              for c in f.fit_after)
             lines.append(f"    held-out gain: {gain}")
         lines.append(f"    evidence: {f.evidence}")
+    before = [c for c in result.consistency_calibrated if c.violated]
     broken = [c for c in result.consistency if c.violated]
     lines.append(f"consistency: {len(result.consistency)} relations checked, "
-                 f"{len(broken)} violated" + (":" if broken else ""))
+                 f"{len(before)} violated under the calibrated model, {len(broken)} under the "
+                 "extended one" + (":" if broken else ""))
     lines.extend(f"  {c.describe()}" for c in broken)
     lines.extend(f"  note: {problem}" for problem in result.problems)
     return "\n".join(lines)

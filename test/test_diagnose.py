@@ -48,6 +48,8 @@ def test_a_campaign_without_extra_effect_gives_none(reference, tmp_path):
     result = diagnose(runs, reference)
     assert result.verdict == "none", [f.evidence for f in result.findings]
     assert result.findings == []
+    assert result.consistency_calibrated and not any(
+        c.violated for c in result.consistency_calibrated)
 
 
 def test_actuator_delay_is_named_and_measured_within_a_millisecond(reference, tmp_path):

@@ -76,7 +76,7 @@ def test_an_outside_controller_at_100_hz_drives_the_valve_by_time_in_real_time(t
     # the valve moves by time, as fast as offline: stepped per message it took DECIMATION
     # times as long. Not slower is all real time can promise: a command that reaches the
     # valve a control period (40 ms) late finds the plant's samples of that interval taken
-    # already, and the rise (~30 ms) shows as a jump (ratio 0 seen once in a busy suite)
+    # already, and the rise (~30 ms) shows as a jump (ratio 0 seen twice, the machine busy)
     ratio = _rise_s(recorded) / _rise_s(_rerun(tmp_path / "bag"))
     assert ratio < 1.6, ratio
 

@@ -17,6 +17,7 @@ from landing_gear_sim.model.elements import slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import (
     gear_walk_modes,
+    load_factor_at,
     peak_friction,
     rim_speed_m_s,
     rolling_radius_at,
@@ -95,7 +96,7 @@ def braking_metrics(run: Run, rig: RigParameters) -> BrakingMetrics:
         stopping_distance_m=float(scipy.integrate.trapezoid(speed, t)),
         stopping_time_s=duration,
         mean_deceleration_m_s2=float(speed[0] - speed[-1]) / max(duration, 1e-9),
-        braking_efficiency=_efficiency(rig, friction, speed[loaded], peak),
+        braking_efficiency=_efficiency(rig, friction, speed[loaded], load[loaded], peak),
         mean_friction=float(np.mean(friction)),
         peak_friction=peak,
         slip_rms=float(np.sqrt(np.mean(slip[moving] ** 2))) if moving.any() else 0.0,
@@ -109,16 +110,17 @@ def braking_metrics(run: Run, rig: RigParameters) -> BrakingMetrics:
 
 
 def _efficiency(rig: RigParameters, friction: np.ndarray, speed_m_s: np.ndarray,
-                peak: float) -> float:
-    """Mean friction used over the friction available; on a runway whose surface changes
-    below ``friction.change_speed_m_s`` (a μ-jump) each sample counts against its own
-    surface's peak."""
+                load_n: np.ndarray, peak: float) -> float:
+    """Mean friction used over the friction available, sample by sample: the peak at the
+    sample's load (a tyre's load sensitivity) and, on a runway whose surface changes below
+    ``friction.change_speed_m_s`` (a μ-jump), of the surface under the tyre."""
+    available = peak * load_factor_at(rig, load_n)
     change = rig.number("friction.change_speed_m_s")
-    if change <= 0.0:
-        return float(np.mean(friction)) / peak
-    after, _ = peak_friction(rig.replace({f"friction.theta{i}": rig.number(
-        f"friction.after_theta{i}") for i in (1, 2, 3)}, "the surface after the change"))
-    return float(np.mean(friction / np.where(speed_m_s < change, after, peak)))
+    if change > 0.0:
+        after, _ = peak_friction(rig.replace({f"friction.theta{i}": rig.number(
+            f"friction.after_theta{i}") for i in (1, 2, 3)}, "the surface after the change"))
+        available = np.where(speed_m_s < change, available * after / peak, available)
+    return float(np.mean(friction / available))
 
 
 def _cycling_frequency(pressure_pa: np.ndarray, duration_s: float) -> float:

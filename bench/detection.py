@@ -53,6 +53,7 @@ class Case:
     tolerance: float  # absolute if ``absolute`` else relative
     absolute: bool = False
     without: tuple[str, ...] = ()
+    light: bool = False  # the campaign needs the light stops (runs at another static load)
 
 
 def _number(key: str) -> Truth:
@@ -130,21 +131,28 @@ FAMILIES: dict[str, Case] = {
         "gain_drift_per_run", _number("brake.gain_drift_per_run"), 0.2),
     "wheel_angle": Case(_runout, _runout_order,
                         lambda rig: rig.number(f"sensors.{_runout_order(rig)}"), 0.1),
+    "load": Case(
+        lambda r, d: {"friction.load_sensitivity_per_n":
+                      r.choice([-1, 1]) * r.uniform(0.06, 0.15) / 1e4},  # 6-15 % per 10 kN
+        "load_sensitivity_per_n", _number("friction.load_sensitivity_per_n"), 0.2, light=True),
     "input_history": Case(
         lambda r, d: {"actuator.backlash_a": r.uniform(0.004, 0.04)},
         "backlash_a", _number("actuator.backlash_a"), 0.2),
 }
 
 
-def run_case(cause: str | None, seed: int, datasheet: RigParameters) -> tuple[bool, str, float]:
-    """Diagnose one generated campaign; (correct, verdict, key-parameter error)."""
+def run_case(cause: str | None, seed: int, datasheet: RigParameters, light: bool = False
+             ) -> tuple[bool, str, float]:
+    """Diagnose one generated campaign (with the light stops when ``light`` or when the
+    cause needs them); (correct, verdict, key-parameter error)."""
     rng = np.random.default_rng(seed)
     rig = rig_like(datasheet, rng)
     case = (CASES | FAMILIES).get(cause) if cause else None
     if case is not None:
         rig = rig.replace(case.draw(rng, datasheet), "hidden effect")
     with tempfile.TemporaryDirectory() as folder:
-        generate_campaign(Path(folder), rig, seed)
+        generate_campaign(Path(folder), rig, seed, light=light or (case is not None
+                                                                   and case.light))
         runs = read_campaign(Path(folder)).runs
     result = diagnose(runs, datasheet, without=list(case.without) if case else [])
     if case is None:
@@ -175,10 +183,10 @@ def _within(case: Case, value: float, rig: RigParameters, verdict: str
     return error <= case.tolerance, verdict, error
 
 
-def case_task(cause: str | None, seed: int) -> dict:
+def case_task(cause: str | None, seed: int, light: bool = False) -> dict:
     """One campaign of the sweep, as a journal row."""
     started = time.perf_counter()
-    ok, verdict, error = run_case(cause, seed, load_parameters())
+    ok, verdict, error = run_case(cause, seed, load_parameters(), light)
     return {"cause": cause or "none", "seed": seed, "ok": ok, "verdict": verdict,
             "error": None if math.isnan(error) else error,
             "seconds": round(time.perf_counter() - started, 1)}
@@ -200,13 +208,16 @@ def main() -> None:
     parser.add_argument("--scheduler", help="a running Dask scheduler (default: local)")
     parser.add_argument("--workers", type=int, help="local cluster: worker processes")
     parser.add_argument("--journal", type=Path, help="default out/detection/seed-S.jsonl")
+    parser.add_argument("--light-runs", action="store_true",
+                        help="every campaign with the light stops (the load family always)")
     args = parser.parse_args()
     plan = [(c, args.seed + 17 * i + j) for i, c in enumerate(args.causes.split(","))
             for j in range(args.per_cause)]
     plan += [(None, args.seed + 900 + j) for j in range(args.nulls)]
-    tasks = [Task(f"{cause or 'none'}-{seed}", case_task, (cause, seed))
+    light = "-light" if args.light_runs else ""
+    tasks = [Task(f"{cause or 'none'}-{seed}{light}", case_task, (cause, seed, args.light_runs))
              for cause, seed in plan]
-    journal = args.journal or Path("out/detection") / f"seed-{args.seed}.jsonl"
+    journal = args.journal or Path("out/detection") / f"seed-{args.seed}{light}.jsonl"
     print(f"{'hidden':24s} {'seed':>6s} {'verdict':24s} {'key error':>10s} {'ok':>4s} {'s':>6s}",
           flush=True)
     with client(args.scheduler, args.workers) as engine:

@@ -11,11 +11,24 @@ import pytest
 
 from landing_gear_sim.calibration import runs as runs_module
 from landing_gear_sim.calibration.braking import prepare
-from landing_gear_sim.calibration.campaign import DEVIATING, generate_campaign, rig_like
+from landing_gear_sim.calibration.campaign import (
+    DEVIATING,
+    LIGHT_BAR,
+    LIGHT_LOAD,
+    generate_campaign,
+    rig_like,
+)
 from landing_gear_sim.calibration.friction import fit_friction
 from landing_gear_sim.calibration.identify import identify
-from landing_gear_sim.calibration.measured import simulate_run
-from landing_gear_sim.calibration.runs import Family, RunKind, classify, classify_all, select
+from landing_gear_sim.calibration.measured import run_static_load_n, simulate_run
+from landing_gear_sim.calibration.runs import (
+    Family,
+    RunKind,
+    classified,
+    classify,
+    classify_all,
+    select,
+)
 from landing_gear_sim.calibration.validate import fit_percent, validate
 from landing_gear_sim.cli import main
 from landing_gear_sim.model.integrate import simulate
@@ -146,6 +159,8 @@ def test_campaign_cli_refuses_to_overwrite(tmp_path, capsys):
     assert "not empty" in capsys.readouterr().err
     assert main(["campaign", str(tmp_path / "new"), "--seed", "3"]) == 0
     assert len(list((tmp_path / "new").glob("*.csv"))) == 8
+    assert main(["campaign", str(tmp_path / "light"), "--light-runs"]) == 0
+    assert len(list((tmp_path / "light").glob("*_light.csv"))) == len(LIGHT_BAR)
 
 
 def test_a_model_that_stops_early_still_follows_the_valve_pressure(campaign_dir, reference):
@@ -187,6 +202,24 @@ def test_simulating_a_measured_run_never_adds_noise(campaign_dir, reference):
     clean = simulate_run(run, reference)[0]
     assert np.array_equal(first.pressure_pa, second.pressure_pa)
     assert np.array_equal(first.wheel_speed_rad_s, clean.wheel_speed_rad_s)
+
+
+def test_a_run_at_another_static_load_is_simulated_at_its_own(tmp_path, identified,
+                                                              hidden_rig):
+    """The generator's light stops run at a lighter static load; a simulation of a measured
+    run takes the run's own load from its free rolling (like its initial speed), so the
+    vertical load channel is followed there as on every other stop."""
+    light = f"brake_const_{LIGHT_BAR[0]}bar_light"
+    generate_campaign(tmp_path, hidden_rig, SEED, ["brake_const_20bar", light], light=True)
+    runs = {r.name: r for r in read_campaign(tmp_path).runs}
+    full = hidden_rig.number("loading.static_load_n")
+    for name, share in (("brake_const_20bar", 1.0), (light, LIGHT_LOAD)):
+        run = classified(runs[name])
+        assert run_static_load_n(run, identified.params) == pytest.approx(share * full,
+                                                                          rel=2e-3)
+        simulated = simulate_run(run, identified.params)[0]
+        # at the model's static load the light stop's fit is negative
+        assert fit_percent(run.vertical_load_n, simulated.vertical_load_n) > 95.0, name
 
 
 COMPARED = ("actuator.map_k1_pa_per_a", "actuator.natural_frequency_hz",

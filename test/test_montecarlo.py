@@ -17,7 +17,7 @@ from antiskid.metrics import braking_metrics
 from landing_gear_sim.campaigns.montecarlo import Plan, draw_case
 from landing_gear_sim.cli import main
 from landing_gear_sim.model.integrate import simulate
-from landing_gear_sim.model.quantities import peak_friction
+from landing_gear_sim.model.quantities import at_static_load, peak_friction
 from landing_gear_sim.model.runspec import RunSpec
 from landing_gear_sim.ros.graph import load_scenario
 from msg_tools.io import read_run
@@ -31,8 +31,10 @@ GAIN = "brake.gain_n_m_per_pa"
 def test_the_compiled_closed_loop_is_the_block_loop_to_the_last_bit(reference, kind, delay_s,
                                                                     runout):
     """What the graph steps (blocks) and what Monte Carlo runs (one compiled loop) agree,
-    the wheel channel read out of step and rippling with the wheel's angle included."""
+    the wheel channel read out of step and rippling with the wheel's angle, and a
+    load-sensitive tyre, included."""
     rig = with_surface(reference, "wet").replace({
+        "friction.load_sensitivity_per_n": 1e-5 if runout else 0.0,
         "sensors.wheel_speed_delay_s": delay_s, "sensors.wheel_runout_1": runout,
         "sensors.wheel_runout_1_phase_rad": 0.7, "sensors.wheel_runout_2": runout / 2})
     blocks = closed_loop(rig, make_controller(kind, rig, 1e-3))
@@ -63,6 +65,17 @@ def test_efficiency_counts_each_sample_against_the_surface_under_the_tyre(refere
     rig = _jump(reference, 30.0)
     metrics = braking_metrics(compiled_closed_loop(rig, "slip").to_run(), rig)
     assert 0.85 < metrics.braking_efficiency <= 1.0  # against the dry peak alone: ~0.4
+
+
+def test_efficiency_counts_each_sample_against_the_friction_at_its_load(reference):
+    """A load-sensitive tyre (μ 20 % up per 10 kN lighter) at 75 % static load: against the
+    curve's peak at the reference load the slip controller would use more than all of it."""
+    rig = at_static_load(reference.replace({"friction.load_sensitivity_per_n": 2e-5}),
+                         0.75 * reference.number("loading.static_load_n"))
+    run = compiled_closed_loop(rig, "slip").to_run()
+    metrics = braking_metrics(run, rig)
+    assert metrics.mean_friction > metrics.peak_friction  # the reference load's peak
+    assert 0.85 < metrics.braking_efficiency <= 1.0
 
 
 def test_a_case_depends_on_the_seed_and_its_index_only(reference):

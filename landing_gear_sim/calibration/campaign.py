@@ -17,6 +17,7 @@ from landing_gear_sim.calibration.measured import run_parameters
 from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.quantities import at_static_load
 from landing_gear_sim.model.sensors import RUNOUT_KEYS, SensorModel
 from msg_tools.csv_io import write_csv
 from msg_tools.units import PA_PER_BAR
@@ -30,6 +31,18 @@ DEVIATING = ("flywheel.inertia_kg_m2", "drag.coeff_n_s2_per_m2", "friction.theta
 NOISE = {"sensors.pressure_noise_pa": 1.5e4, "sensors.speed_noise_rad_s": 0.1,
          "sensors.force_noise_n": 100.0}
 GENERATING_FILE = "generating-parameters.yaml"
+LIGHT_LOAD = 0.7
+LIGHT_BAR = (14, 21, 28)
+LIGHT_SPEED_M_S = 45.0
+"""The light stops (``light=True``): constant-pressure stops at a lighter static load
+(× LIGHT_LOAD). On the rig the load follows the speed (F_z0 − k_L v²), so only runs at
+another static load tell a law in load (a tyre's load sensitivity) from one in speed. Their
+pressures are the 20, 30 and 40 bar stops' × LIGHT_LOAD: the same brake torque per newton of
+load, so the same slips, on a slippery surface as on a grippy one (two light stops at the
+full pressures shared too few slips with the others: the comparison went unchecked on a
+slippery rig). They start slower, where the lift leaves the lighter tyre most of its load.
+Not in the default campaign: the example campaigns' eight runs take 15 s to diagnose, the
+eleven 21 s."""
 
 
 def rig_like(datasheet: RigParameters, rng: np.random.Generator,
@@ -40,10 +53,12 @@ def rig_like(datasheet: RigParameters, rng: np.random.Generator,
     return datasheet.replace({**changes, **NOISE}, "rig generator")
 
 
-def standard_scenarios(p: RigParameters) -> dict[str, sc.Scenario]:
-    """The runs of a calibration campaign (same names as the example campaigns)."""
+def standard_scenarios(p: RigParameters, light: bool = False) -> dict[str, sc.Scenario]:
+    """The runs of a calibration campaign: those of the example campaigns (same names), and
+    with ``light`` the constant-pressure stops at a lighter static load (`_light`, see
+    LIGHT_BAR)."""
     max_current = p.number("actuator.max_current_a")
-    return {
+    standard = {
         "actuator_ramp": sc.actuator_test(p, sc.quasi_static_ramp(max_current), 20.0,
                                           "actuator_ramp"),
         "actuator_steps_sweep": sc.actuator_test(p, sc.steps_then_sweep(), 28.0,
@@ -53,6 +68,11 @@ def standard_scenarios(p: RigParameters) -> dict[str, sc.Scenario]:
         "brake_osc_low": sc.rig_test(p, sc.oscillating(**sc.OSC_LOW), "brake_osc_low"),
         "brake_osc_high": sc.rig_test(p, sc.oscillating(**sc.OSC_HIGH), "brake_osc_high"),
     }
+    if not light:
+        return standard
+    return standard | {f"brake_const_{bar}bar_light": sc.rig_test(
+        _light(p), sc.constant(sc.current_for_pressure(p, bar * PA_PER_BAR)),
+        f"brake_const_{bar}bar_light") for bar in LIGHT_BAR}
 
 
 def _campaign_order(braking: Sequence[str]) -> dict[str, float]:
@@ -73,20 +93,31 @@ def _start_angle(params: RigParameters, rng: np.random.Generator) -> RigParamete
                           "the run's start angle")
 
 
+def _light(params: RigParameters) -> RigParameters:
+    """The set of a `_light` run: LIGHT_LOAD of the static load, from LIGHT_SPEED_M_S."""
+    return at_static_load(params, LIGHT_LOAD * params.number("loading.static_load_n")).replace(
+        {"rig_test.initial_speed_m_s": LIGHT_SPEED_M_S}, "a light run")
+
+
+def _loaded(params: RigParameters, name: str) -> RigParameters:
+    """The set a run brakes with (a `_light` run's, see LIGHT_BAR)."""
+    return _light(params) if name.endswith("_light") else params
+
+
 def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,
-                      names: Sequence[str] | None = None) -> list[Path]:
-    """Simulate and write the standard runs of ``rig`` (or those in ``names``) into
-    ``folder``; returns the CSV paths."""
+                      names: Sequence[str] | None = None, light: bool = False) -> list[Path]:
+    """Simulate and write the standard runs of ``rig`` (or those in ``names``), with
+    ``light`` the light stops too (see LIGHT_BAR), into ``folder``; returns the CSV paths."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     written = []
-    scenarios = standard_scenarios(rig)
+    scenarios = standard_scenarios(rig, light)
     order = _campaign_order([n for n, s in scenarios.items() if s.contact
                              and (names is None or n in names)])
     for i, (name, scenario) in enumerate(scenarios.items()):
         if names is not None and name not in names:
             continue
-        params = _start_angle(run_parameters(rig, order.get(name, 0.0)),
+        params = _start_angle(_loaded(run_parameters(rig, order.get(name, 0.0)), name),
                               np.random.default_rng([seed, i]))
         run = simulate(params, scenario).to_run(noise=seed * 100 + i)
         path = folder / f"{name}.csv"

@@ -16,7 +16,7 @@ from landing_gear_sim.calibration.statistics import Estimate, covariance_std, ru
 from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model.elements import burckhardt_mu, slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.model.quantities import rolling_radius_at
+from landing_gear_sim.model.quantities import load_factor_at, rolling_radius_at
 
 KEYS = ("friction.theta1", "friction.theta2", "friction.theta3")
 REFINE_BOUNDS = (0.2, 5.0)  # output-error refinement stays within these factors of the start
@@ -28,19 +28,27 @@ REFINE_ITERATIONS = 12
 
 def friction_samples(runs: Sequence[Braking], p: RigParameters
                      ) -> tuple[np.ndarray, np.ndarray]:
-    """(slip, μ) from eq. (1) and μ = F_x/F_z over the braking phases, decimated to 100 Hz."""
+    """(slip, μ) from eq. (1) and μ = F_x/F_z over the braking phases, decimated to 100 Hz
+    (μ of the curve: the model's load sensitivity taken off)."""
     per_run = [_run_samples(b, p) for b in runs]
     return (np.concatenate([slip for slip, _ in per_run]),
             np.concatenate([mu for _, mu in per_run]))
 
 
 def _run_samples(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
+    idx = friction_indices(b, p)
+    load = b.load[idx]
+    mu = b.force[idx] / (load * load_factor_at(p, load))
+    return slip_ratio(hub_speed(b, p)[idx], b.wheel[idx], rolling_radius_at(p, load)), mu
+
+
+def friction_indices(b: Braking, p: RigParameters) -> np.ndarray:
+    """Samples of ``b`` (indices) that carry the friction curve: braking, loaded, the wheel
+    turning, above the stop speed; at 100 Hz."""
     stop = p.number("rig_test.stop_speed_m_s")
     m = (b.time_s > b.start_s + 0.3) & (b.speed_m_s > stop + 2.0) & (b.load > LOADED_N) \
         & (b.wheel > 1.0)
-    idx = np.flatnonzero(m)[::10]
-    radius = rolling_radius_at(p, b.load[idx])
-    return slip_ratio(hub_speed(b, p)[idx], b.wheel[idx], radius), b.force[idx] / b.load[idx]
+    return np.flatnonzero(m)[::10]
 
 
 def fit_friction(runs: Sequence[Braking], p: RigParameters, fix_theta3: bool = False

@@ -13,10 +13,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from landing_gear_sim.calibration.runs import ClassifiedRun, classified
-from landing_gear_sim.calibration.wheel_angle import measured_angle_rad, run_phases
+from landing_gear_sim.calibration.wheel_angle import free_rolling, measured_angle_rad, run_phases
 from landing_gear_sim.model.integrate import SimulationResult, simulate
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.model.quantities import rim_speed_m_s
+from landing_gear_sim.model.quantities import at_static_load, rim_speed_m_s
 from landing_gear_sim.model.scenario import Scenario, logged_to_held
 from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.run import Run
@@ -33,6 +33,8 @@ ACTUATOR_CHANNELS = ("pressure_pa",)
 """An actuator-only run carries information on the pressure alone."""
 LOWEST_SIM_SPEED_M_S = 1.0  # below this slip is ill-defined; the rig stops at 3 m/s
 INITIAL_SPEED_SAMPLES = 20  # the initial speed is the mean of this many samples
+STATIC_LOAD_SAMPLES = 100  # fewer free-rolling samples: the model's static load is kept
+SAME_LOAD = 0.01  # a run within 1 % of the model's static load is at the device's set point
 
 
 def channels_of(run: ClassifiedRun) -> tuple[str, ...]:
@@ -64,6 +66,30 @@ def run_parameters(params: RigParameters, campaign_order: float) -> RigParameter
                           "run in the campaign")
 
 
+def run_static_load_n(run: ClassifiedRun, params: RigParameters) -> float | None:
+    """The static load the loading device held in ``run`` [N]: the mean of F_z + k_L v² in
+    the free rolling before the brake acts (the load settled and the speed nearly steady, so
+    the servo's lag is nil); None when the run has too little free rolling."""
+    mask = free_rolling(run) if run.braking else np.zeros(len(run), dtype=bool)
+    if mask.sum() < STATIC_LOAD_SAMPLES:
+        return None
+    speed = rim_speed_m_s(params, run.flywheel_speed_rad_s[mask])
+    lift = params.number("loading.lift_coeff_n_s2_per_m2")
+    return float(np.mean(run.vertical_load_n[mask] + lift * speed * speed))
+
+
+def _at_run_load(params: RigParameters, run: ClassifiedRun) -> RigParameters:
+    """The set with the loading device at the run's own static load (like its initial
+    speed: a campaign may brake at several), the friction curve's reference load kept; the
+    model's own when the run's is within SAME_LOAD of it (the estimate's few newtons of
+    noise only perturbed the fits: a pressure slope moved by 4 %)."""
+    load = run_static_load_n(run, params)
+    model = params.number("loading.static_load_n")
+    if load is None or abs(load - model) <= SAME_LOAD * model:
+        return params
+    return at_static_load(params, load, "the run's static load")
+
+
 def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult]:
     """Simulate ``run`` with its measured current; the result on the run's (uniform, see
     :func:`~landing_gear_sim.calibration.runs.classified`) time base.
@@ -71,12 +97,13 @@ def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult
     If the model stops (speed below 1 m/s) before the measurement ends, the last
     simulated sample is held, so both have the same length, except the pressure: the
     valve goes on following the measured current. The touch-down time is the run's
-    start, as in the rig procedure. A wheel encoder that ripples with the wheel's angle
+    start, as in the rig procedure; the loading device holds the run's own static load. A
+    wheel encoder that ripples with the wheel's angle
     ripples at the measured angle, with the run's own phase (see
     :mod:`~landing_gear_sim.calibration.wheel_angle`).
     """
     run = classified(run)
-    params = run_parameters(params, run.campaign_order)
+    params = _at_run_load(run_parameters(params, run.campaign_order), run)
     angle = None
     if run.braking and SensorModel.of(params).ripples:
         params, angle = run_phases(params, run), measured_angle_rad(run)

@@ -55,6 +55,19 @@ def linear_std(design: np.ndarray, residual: np.ndarray, n_params: int) -> np.nd
     return np.sqrt(np.clip(np.diag(cov), 0.0, None))
 
 
+def cluster_std(design: np.ndarray, residual: np.ndarray, sizes: Sequence[int]) -> np.ndarray:
+    """1-σ of a least-squares fit whose samples come in clusters (runs) of ``sizes``, in
+    order: the sandwich (XᵀX)⁻¹ Σ_g X_gᵀ u_g u_gᵀ X_g (XᵀX)⁻¹ · G/(G − 1), so that an
+    error shared within a run but not from run to run counts once per run; shape (k,)."""
+    bread = np.linalg.pinv(design.T @ design)
+    cuts = np.cumsum(sizes)[:-1]
+    scores = np.array([x.T @ u for x, u in zip(np.split(design, cuts),
+                                                np.split(residual, cuts), strict=True)])
+    groups = len(sizes)
+    cov = bread @ (scores.T @ scores) @ bread * groups / max(groups - 1, 1)
+    return np.sqrt(np.clip(np.diag(cov), 0.0, None))
+
+
 def inverse_variance_weights(values: np.ndarray, std: np.ndarray) -> np.ndarray:
     """1/σ² of each value; a σ of 0 (a value held fixed) is floored at 1e-9 of the values'
     scale, so it cannot weigh infinitely."""

@@ -26,6 +26,7 @@ from antiskid.metrics import braking_metrics
 from landing_gear_sim.errors import LandingGearSimError
 from landing_gear_sim.model.integrate import SimulationResult
 from landing_gear_sim.model.parameters import SPECS, RigParameters
+from landing_gear_sim.model.quantities import REFERENCE_LOAD, STATIC_LOAD, at_static_load
 
 SURFACE_KINDS = ("dry", "wet", "snow", "jump")
 """``jump``: dry, then wet or snow below a speed drawn in ``jump_speed_m_s``."""
@@ -98,6 +99,12 @@ class Case:
         return f"case-{self.index:05d}-{self.surface}"
 
 
+def _static_load(base: RigParameters, factor: float) -> dict[str, float]:
+    """The drawn static load, the friction curve's reference load kept at the base's."""
+    loaded = at_static_load(base, factor * base.number(STATIC_LOAD))
+    return {key: loaded.number(key) for key in (STATIC_LOAD, REFERENCE_LOAD)}
+
+
 def draw_case(base: RigParameters, plan: Plan, index: int) -> Case:
     """Case ``index`` of ``plan``: a function of (seed, index) only."""
     rng = np.random.default_rng([plan.seed, index])
@@ -106,7 +113,7 @@ def draw_case(base: RigParameters, plan: Plan, index: int) -> Case:
     factor = float(rng.uniform(*plan.load_factor))
     overrides = _drawn_parameters(base, plan.sigma, rng)
     overrides["rig_test.initial_speed_m_s"] = speed
-    overrides["loading.static_load_n"] = factor * base.number("loading.static_load_n")
+    overrides |= _static_load(base, factor)
     jump = math.nan
     if surface == "jump":
         after = str(rng.choice(sorted(SURFACES)))

@@ -91,6 +91,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     gen.add_argument("--seed", type=int, default=1)
     gen.add_argument("--deviation", type=float, default=0.03,
                      help="largest relative deviation of the rig from the datasheet")
+    gen.add_argument("--light-runs", action="store_true",
+                     help="also brake three stops at 70 %% of the static load (14, 21, 28 bar): "
+                          "what shows a tyre's friction changing with the load")
     gen.set_defaults(func=cmd_campaign)
 
     conv = sub.add_parser("convert", help="convert a run between CSV and rosbag2")
@@ -252,7 +255,7 @@ def cmd_campaign(args: argparse.Namespace) -> int:
     rig = rig_like(params_of(args), np.random.default_rng(args.seed), args.deviation)
     progress(f"simulating a synthetic campaign (seed {args.seed}, datasheet "
               f"±{100 * args.deviation:g} %)")
-    for path in generate_campaign(args.output, rig, args.seed):
+    for path in generate_campaign(args.output, rig, args.seed, light=args.light_runs):
         print(f"  {path}")
     print(f"generating parameters (for checks only): {args.output / GENERATING_FILE}")
     return 0

@@ -35,6 +35,7 @@ from landing_gear_sim.diagnosis.consistency import (
     Check,
     check_campaign,
     inconsistent,
+    unchecked_relations,
     violations,
 )
 from landing_gear_sim.diagnosis.findings import Finding, Signature
@@ -180,6 +181,7 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     say("checking the relations the rig measures twice")
     checks = check_campaign(runs, model)
     calibrated_checks = checks if model is calibrated else check_campaign(runs, calibrated)
+    problems.extend(unchecked_relations(runs, calibrated_checks))
     if not accepted:
         found = discovered.discover(runs, model, base, scales, before, checks, say)
         if found is not None:

@@ -10,6 +10,7 @@ reported under the name of a catalogued effect that bent to it.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import replace
 
@@ -19,8 +20,10 @@ from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.diagnosis.catalogue import Candidate, Scales
 from landing_gear_sim.diagnosis.consistency import (
     FREE_ROLLING,
+    FRICTION_IN_LOAD,
     GAIN_IN_PRESSURE,
     GAIN_IN_SPEED,
+    LOAD_UNIT_N,
     RUN_DRIFT,
     VALVE_DIRECTION,
     WHEEL_ANGLE,
@@ -34,6 +37,7 @@ from landing_gear_sim.diagnosis.discovery import (
     discovered_candidate,
     drift_candidate,
     families,
+    load_candidate,
     runout_candidate,
     select_brake_terms,
     select_channel_terms,
@@ -81,12 +85,18 @@ def discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: Rig
     if scored is None or not scored.finding.accepted:
         for candidate in _gain_candidates(runs, braking, model, checks):
             scored = _better(scored, _score_discovered(candidate, runs, model, datasheet,
-                                                       scales, signatures, say))
+                                                       scales, signatures, say), runs)
+    friction = [c for c in violations(checks) if c.relation == FRICTION_IN_LOAD]
+    if friction and (scored is None or not scored.finding.accepted):
+        candidate = load_candidate(-friction[0].deviation / LOAD_UNIT_N, model)
+        scored = _better(scored, _score_discovered(candidate, runs, model, datasheet, scales,
+                                                   signatures, say), runs)
     return None if scored is None else _called_for(scored, checks)
 
 
 CALLED_FOR = {"input_history": (VALVE_DIRECTION,), "wheel_angle": (WHEEL_ANGLE,),
-              "channel_crosstalk": (FREE_ROLLING,), "run_drift": (RUN_DRIFT,)}
+              "channel_crosstalk": (FREE_ROLLING,), "run_drift": (RUN_DRIFT,),
+              "load": (FRICTION_IN_LOAD,)}
 """The relations whose violation calls for each family (the brake-gain laws: their own)."""
 
 
@@ -122,12 +132,20 @@ def _gain_candidates(runs: Sequence[ClassifiedRun], braking: Sequence[br.Braking
     return candidates
 
 
-def _better(first: Scored | None, second: Scored | None) -> Scored | None:
-    """The accepted one, or of two accepted (or two not) the one with the lower ΔBIC."""
+def _better(first: Scored | None, second: Scored | None,
+            runs: Sequence[ClassifiedRun]) -> Scored | None:
+    """The accepted one; of two accepted, the one that leaves fewer relations violated, then
+    the one that predicts the held-out runs better (a drift through a campaign in rising
+    pressure order fits a pressure law nearly as well in sample: ΔBIC −94 against −115
+    once, held out −144 against −101); of two not accepted, the lower ΔBIC."""
     if first is None or second is None:
         return first or second
-    def rank(s: Scored) -> tuple[bool, float]:
-        return not s.finding.accepted, s.finding.delta_bic or 0.0
+    both = first.finding.accepted and second.finding.accepted
+    def rank(s: Scored) -> tuple[bool, int, float]:
+        if not both:
+            return not s.finding.accepted, 0, s.finding.delta_bic or 0.0
+        held_out = s.finding.held_out if s.finding.held_out is not None else math.inf
+        return False, len(violations(check_campaign(runs, s.fit.params))), held_out
     return min(first, second, key=rank)
 
 

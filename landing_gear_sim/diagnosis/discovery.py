@@ -1,5 +1,6 @@
 """Discovery of terms the catalogue lacks (issue 14, part 3: brake torque, load-cell channels,
-the wheel channel's timing and its ripple with the wheel's angle, the valve's play).
+the wheel channel's timing and its ripple with the wheel's angle, the valve's play, the
+tyre's friction in load).
 
 When the brake-gain consistency checks are violated, the wheel's torque balance
 r F_x − J_w ω̇ = k_b P (1 + Σ c_i x_i) is regressed on a library of physical terms x_i
@@ -235,6 +236,19 @@ def runout_candidate(orders: dict[str, float]) -> Candidate:
                      ("wheel_speed_rad_s",), (), tuple((k.split(".")[1], k) for k in keys))
 
 
+LOAD_KEY = "friction.load_sensitivity_per_n"
+
+
+def load_candidate(start_per_n: float, params: RigParameters) -> Candidate:
+    """μ scaled by 1 − κ (F_z − F_ref) (``load``: a tyre's load sensitivity), started at
+    ``start_per_n`` [1/N] (from the consistency check) and fitted with the friction curve
+    (which the calibration bent to it) on the braking runs."""
+    bound = 0.5 / params.number("loading.static_load_n")  # μ halved across F_z0 at most
+    start = float(np.clip(start_per_n, -0.9 * bound, 0.9 * bound))
+    return Candidate(DISCOVERED, None, (LOAD_KEY,), ((start,),), ((-bound, bound),), FRICTION,
+                     BRAKE_RUNS, WHEEL, (), (("load_sensitivity_per_n", LOAD_KEY),))
+
+
 def discovered_candidate(terms: dict[LibraryTerm, float]) -> Candidate:
     """The kept brake terms as a candidate, fitted with k_b and the friction curve."""
     return _term_candidate(terms, ("brake.gain_n_m_per_pa", *FRICTION), WHEEL)
@@ -256,6 +270,8 @@ def families(candidate: Candidate) -> str:
         return "wheel_angle"
     if SKEW_KEY in candidate.keys:
         return "channel_skew"
+    if LOAD_KEY in candidate.keys:
+        return "load"
     if BACKLASH_KEY in candidate.keys:
         return "input_history"
     if DRIFT_KEY in candidate.keys:
@@ -273,6 +289,12 @@ def term_formula(candidate: Candidate, params: RigParameters) -> str:
         return f"ω_read = ω·(1 + {' + '.join(waves)}), θ: wheel angle, φ: each run's own"
     if SKEW_KEY in candidate.keys:
         return f"ω_read(t) = ω(t − {1e3 * params.number(SKEW_KEY):.1f} ms)"
+    if LOAD_KEY in candidate.keys:
+        per_kn = 1e5 * params.number(LOAD_KEY)
+        reference = params.number("friction.reference_load_n") or params.number(
+            "loading.static_load_n")
+        return (f"μ = μ_B(λ)·(1 {'−' if per_kn >= 0 else '+'} {abs(per_kn):.3f} %/kN·(F_z − "
+                f"{reference / 1e3:.1f} kN))")
     if BACKLASH_KEY in candidate.keys:
         half = 500 * params.number(BACKLASH_KEY)
         return f"P_static = map(i_v), i_v = play(i, ±{half:.1f} mA)"

@@ -65,6 +65,8 @@ MAP_K1 = INDEX["actuator.map_k1_pa_per_a"]
 MAP_K2 = INDEX["actuator.map_k2_pa_per_a2"]
 MAX_PRESSURE = INDEX["actuator.max_pressure_pa"]
 LOAD_STATIC = INDEX["loading.static_load_n"]
+LOAD_SENSITIVITY = INDEX["friction.load_sensitivity_per_n"]
+LOAD_REFERENCE = INDEX["friction.reference_load_n"]
 LIFT = INDEX["loading.lift_coeff_n_s2_per_m2"]
 LOAD_TAU = INDEX["loading.servo_time_constant_s"]
 TOUCHDOWN_RAMP = INDEX["loading.touchdown_ramp_s"]
@@ -77,25 +79,39 @@ def burckhardt_mu(theta1, theta2, theta3, slip):
     return theta1 * (1.0 - np.exp(-theta2 * slip)) - theta3 * slip
 
 
+@njit(cache=True, inline="always")
+def load_factor(p, vertical_load_n):
+    """μ's factor for the load: 1 − κ (F_z − F_ref), κ the tyre's load sensitivity, F_ref
+    the reference load (the static load when 0). Branch-free: inside the plant's innermost
+    call a never-taken branch cost 40 % of a stop's time."""
+    reference = p[LOAD_STATIC] + (p[LOAD_REFERENCE] - p[LOAD_STATIC]) * (p[LOAD_REFERENCE] > 0.0)
+    return 1.0 - p[LOAD_SENSITIVITY] * (vertical_load_n - reference)
+
+
 @njit(cache=True)
-def burckhardt(p, slip, speed_m_s):
-    """Friction coefficient μ(λ) of the surface under the tyre at vehicle speed
-    ``speed_m_s``, extended odd for λ < 0 (wheel faster than hub). Below
-    ``friction.change_speed_m_s`` (when > 0) the tyre is on the second surface: a stop
-    decelerates monotonically, so a speed marks a place on the runway."""
+def tyre_friction(p, slip, speed_m_s, vertical_load_n):
+    """Friction coefficient of the tyre at slip λ, vehicle speed ``speed_m_s`` and vertical
+    load [N]: μ(λ) of the surface under the tyre times :func:`load_factor`, extended odd for
+    λ < 0 (wheel faster than hub). Below ``friction.change_speed_m_s`` (when > 0) the tyre
+    is on the second surface: a stop decelerates monotonically, so a speed marks a place on
+    the runway."""
     first = THETA1
     if p[CHANGE_SPEED] > 0.0 and speed_m_s < p[CHANGE_SPEED]:
         first = AFTER_THETA1
-    mu = burckhardt_mu(p[first], p[first + 1], p[first + 2], abs(slip))
+    mu = burckhardt_mu(p[first], p[first + 1], p[first + 2], abs(slip)) * load_factor(
+        p, vertical_load_n)
     return mu if slip >= 0.0 else -mu
 
 
 @njit(cache=True)
-def burckhardt_slope_max(p):
-    """Largest |dμ/dλ| of the curves (at λ = 0): the tyre's stiffest point."""
+def burckhardt_slope_max(p, max_load_n):
+    """Largest |dμ/dλ| of the curves (at λ = 0) at loads up to ``max_load_n``: the tyre's
+    stiffest point."""
     slope = p[THETA1] * p[THETA2] + p[THETA3]
     if p[CHANGE_SPEED] > 0.0:
         slope = max(slope, p[AFTER_THETA1] * p[AFTER_THETA1 + 1] + p[AFTER_THETA1 + 2])
+    if p[LOAD_SENSITIVITY] != 0.0:
+        slope *= max(load_factor(p, 0.0), load_factor(p, max_load_n), 1.0)
     return slope
 
 

@@ -75,7 +75,7 @@ def operating_point(params: RigParameters, speed_m_s: float, slip: float = 0.05)
     radius = el.rolling_radius(p, load)
     x = np.zeros(N_STATES)
     x[SPEED], x[OMEGA] = speed_m_s, speed_m_s * (1.0 - slip) / radius
-    force = load * el.burckhardt(p, slip, speed_m_s)
+    force = load * el.tyre_friction(p, slip, speed_m_s, load)
     x[TYRE_FORCE] = force
     if params.has("gear_walk"):
         x[ANGLE] = params.number("gear_walk.length_m") * force / params.number(

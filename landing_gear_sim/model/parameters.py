@@ -138,6 +138,13 @@ SPECS: tuple[ParamSpec, ...] = (
               "relative change of k_b from one braking run of a campaign to the next, in run "
               "order, about the middle run (wear; a campaign-level term: a run simulated on "
               "its own has the middle run's k_b; 0: none)", signed=True, default=0.0),
+    ParamSpec("friction.load_sensitivity_per_n", "1/N",
+              "relative change of mu per N of vertical load above friction.reference_load_n: "
+              "mu = mu_B(slip) (1 - kappa (F_z - F_ref)) (a tyre's load sensitivity; 0: none)",
+              signed=True, default=0.0),
+    ParamSpec("friction.reference_load_n", "N",
+              "vertical load at which the friction curve mu_B holds (0: at "
+              "loading.static_load_n); a run at another static load keeps it", default=0.0),
     *(spec for order in (1, 2) for spec in (
         ParamSpec(f"sensors.wheel_runout_{order}", "-",
                   f"the wheel encoder reads omega (1 + e cos({order} theta + phi)): a ripple "

@@ -51,7 +51,7 @@ N_CHANNELS = len(CHANNELS)
 def tyre_state(p, x, vertical_load_n):
     """Radius [m], hub speed [m/s], slip [-] and tyre force F_x [N] at state ``x``.
 
-    F_x is F_z μ(λ), or the relaxed force state when ``tire_relaxation`` is on.
+    F_x is F_z μ(λ, F_z), or the relaxed force state when ``tire_relaxation`` is on.
     """
     radius = el.rolling_radius(p, vertical_load_n)
     hub = x[SPEED] - p[el.GW_LENGTH] * x[ANGLE_RATE] if p[el.HAS_GEAR_WALK] else x[SPEED]
@@ -59,7 +59,7 @@ def tyre_state(p, x, vertical_load_n):
     if p[el.HAS_RELAXATION]:
         force = x[TYRE_FORCE]
     else:
-        force = vertical_load_n * el.burckhardt(p, slip, x[SPEED])
+        force = vertical_load_n * el.tyre_friction(p, slip, x[SPEED], vertical_load_n)
     return radius, hub, slip, force
 
 
@@ -90,7 +90,7 @@ def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     dx[E_DRAG] = drag * x[SPEED]
     dx[E_SLIP] = fx * (hub - x[OMEGA] * radius)
     dx[E_DAMP] = p[el.GW_DAMPING] * x[ANGLE_RATE] ** 2 if p[el.HAS_GEAR_WALK] else 0.0
-    steady = vertical_load_n * el.burckhardt(p, slip, x[SPEED])
+    steady = vertical_load_n * el.tyre_friction(p, slip, x[SPEED], vertical_load_n)
     dx[TYRE_FORCE] = el.relaxation_rate(p, hub) * (steady - x[TYRE_FORCE])
 
 
@@ -102,7 +102,7 @@ def substep_count(p, x, step_s, max_load_n):
     compliance = radius * radius / p[el.WHEEL_INERTIA] + 1.0 / el.translational_mass(p)
     if p[el.HAS_GEAR_WALK]:
         compliance += p[el.GW_LENGTH] ** 2 / p[el.GW_INERTIA]
-    rate = max(max_load_n * el.burckhardt_slope_max(p) * compliance / hub,
+    rate = max(max_load_n * el.burckhardt_slope_max(p, max_load_n) * compliance / hub,
                el.relaxation_rate(p, hub))
     n_stiff = math.ceil(step_s * rate / STABILITY_MARGIN)
     n_max = math.ceil(step_s / MAX_SUBSTEP_S - 1e-9)

@@ -32,6 +32,12 @@ def friction_at(params: RigParameters, slip: np.ndarray) -> np.ndarray:
     return el.burckhardt_mu(*friction_coefficients(params), np.asarray(slip, dtype=float))
 
 
+def load_factor_at(params: RigParameters, load_n: np.ndarray) -> np.ndarray:
+    """μ's factor 1 − κ (F_z − F_ref) for the tyre's load sensitivity at each vertical load
+    [N], same shape (ones when κ = 0)."""
+    return np.asarray(el.load_factor(params.vector(), np.asarray(load_n, dtype=float)))
+
+
 def friction_coefficients(params: RigParameters) -> tuple[float, float, float]:
     """(ϑ1, ϑ2, ϑ3) of the Burckhardt curve."""
     t1, t2, t3 = (params.number(f"friction.theta{i}") for i in (1, 2, 3))
@@ -70,3 +76,15 @@ def gear_walk_modes(params: RigParameters) -> tuple[float, float]:
     j = params.number("gear_walk.inertia_kg_m2")
     c = params.number("gear_walk.damping_n_m_s_per_rad")
     return math.sqrt(k / j) / (2 * math.pi), c / (2 * math.sqrt(k * j))
+
+
+STATIC_LOAD = "loading.static_load_n"
+REFERENCE_LOAD = "friction.reference_load_n"
+
+
+def at_static_load(params: RigParameters, static_load_n: float,
+                   source: str = "static load") -> RigParameters:
+    """The set with the loading device at ``static_load_n`` [N]: the friction curve's
+    reference load stays where it was (a tyre's load sensitivity acts between the two)."""
+    reference = params.number(REFERENCE_LOAD) or params.number(STATIC_LOAD)
+    return params.replace({STATIC_LOAD: static_load_n, REFERENCE_LOAD: reference}, source)

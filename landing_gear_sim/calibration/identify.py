@@ -38,10 +38,10 @@ from landing_gear_sim.processes import single_threaded_blas
 from msg_tools.run import Run
 
 Progress = Callable[[str], None]
+"""Receives one line of progress at a time."""
 ZERO_BOUND_FRACTION = 1e-3  # a direct-fit ϑ below this fraction of its prior sits on 0
 MAX_THETA1 = 2.0  # μ never exceeds ϑ1; no tyre on a runway grips beyond ~1.3
 MAX_SLIP_STIFFNESS = 200.0  # dμ/dλ at λ = 0, ϑ1 ϑ2 + ϑ3: tyres have 10-50
-"""Receives one line of progress at a time."""
 
 
 @dataclass(frozen=True)
@@ -181,15 +181,16 @@ def _friction_step(state: _Calibration, runs: Sequence[ClassifiedRun],
                    prepared: Sequence[br.Braking], fix_theta3: bool, jackknife: bool) -> None:
     before = state.params
     state.adopt(fit_friction(prepared, state.params, fix_theta3))
-    if not fix_theta3:
-        start = _refinement_start(state.params, before)
-        implausible = _no_tyre_curve(start)
-        if implausible:  # the samples' slips are misread: the simulated stops still tell
-            state.problems.append(f"friction curve: the direct fit is no tyre's curve "
-                                  f"({implausible}); refined from the model's curve")
-            start = start.replace({k: before.number(k) for k in FRICTION_KEYS},
-                                  "refinement start")
-        state.say("refining the friction curve on the braking runs (output error)")
-        refined = refine_friction(runs, start, jackknife)
+    if fix_theta3:
+        return
+    implausible = _no_tyre_curve(state.params)
+    if implausible:  # the samples' slips are misread: keep the model's curve, the stops tell
+        state.problems.append(f"friction curve: the direct fit is no tyre's curve "
+                              f"({implausible}); the model's curve kept or refined")
         state.estimates[:] = [e for e in state.estimates if not e.key.startswith("friction.")]
-        state.adopt(refined)
+        state.params = state.params.replace({k: before.number(k) for k in FRICTION_KEYS},
+                                            "the model's friction curve")
+    state.say("refining the friction curve on the braking runs (output error)")
+    refined = refine_friction(runs, _refinement_start(state.params, before), jackknife)
+    state.estimates[:] = [e for e in state.estimates if not e.key.startswith("friction.")]
+    state.adopt(refined)

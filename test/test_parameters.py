@@ -166,3 +166,12 @@ def test_a_params_file_written_before_the_gain_slopes_and_crosstalk_still_loads(
     assert params.number("brake.gain_slope_pressure_per_pa") == 0.0
     assert params.number("sensors.crosstalk_fx_per_fz") == 0.0
     assert params.number("sensors.wheel_speed_delay_s") == 0.0
+
+
+def test_set_reads_an_exponent_without_a_dot_as_ros_does():
+    """`--set friction.load_sensitivity_per_n=1e-5` was refused ('must be a number, got
+    1e-5'): PyYAML reads an exponent without a dot as text, ROS reads a double."""
+    params = load_parameters(overrides=dict([parse_assignment(
+        "friction.load_sensitivity_per_n=1e-5"), parse_assignment("radius.b_m_per_n=5E-7")]))
+    assert params.number("friction.load_sensitivity_per_n") == 1e-5
+    assert params.number("radius.b_m_per_n") == 5e-7

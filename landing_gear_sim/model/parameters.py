@@ -293,7 +293,7 @@ def load_parameters(
             values[spec.key], origin[spec.key] = spec.default, "default"
     if overrides:
         _check_known(overrides, "--set")
-        values.update(overrides)
+        values.update({key: _as_ros_reads_it(key, value) for key, value in overrides.items()})
         origin.update(dict.fromkeys(overrides, "--set"))
         sources = (*sources, "--set")
     _check_values(values, origin, sources)

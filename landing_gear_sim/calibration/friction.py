@@ -36,7 +36,11 @@ def friction_samples(runs: Sequence[Braking], p: RigParameters
 
 
 def _run_samples(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
-    idx = friction_indices(b, p)
+    return samples_at(b, p, friction_indices(b, p))
+
+
+def samples_at(b: Braking, p: RigParameters, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(slip, μ) of ``b`` at the samples ``idx`` (μ of the curve: the load factor taken off)."""
     load = b.load[idx]
     mu = b.force[idx] / (load * load_factor_at(p, load))
     return slip_ratio(hub_speed(b, p)[idx], b.wheel[idx], rolling_radius_at(p, load)), mu

@@ -33,7 +33,7 @@ import numpy as np
 import scipy.interpolate
 
 from landing_gear_sim.calibration import braking as br
-from landing_gear_sim.calibration.friction import friction_indices, friction_samples
+from landing_gear_sim.calibration.friction import friction_indices, samples_at
 from landing_gear_sim.calibration.measured import run_static_load_n
 from landing_gear_sim.calibration.runs import ClassifiedRun, RunKind
 from landing_gear_sim.calibration.statistics import (
@@ -325,7 +325,7 @@ def _friction_run(b: br.Braking, params: RigParameters) -> Friction | None:
     is not yet the steady μ(λ) F_z); None when it has too few samples."""
     load = run_static_load_n(b.run, params)
     i = friction_indices(b, params)
-    slip, mu = friction_samples([b], params)
+    slip, mu = samples_at(b, params, i)
     keep = (np.abs(b.wheel_rate[i]) < br.STEADY_RATE_RAD_S2) & (slip > MIN_SLIP) & (
         slip < MAX_SLIP)
     if load is None or keep.sum() < MIN_SAMPLES // 4:

@@ -84,6 +84,10 @@ class _Calibration:
         self.estimates.extend(new)
         self.params = self.params.replace({e.key: e.value for e in new}, "identify")
 
+    def forget(self, prefix: str) -> None:
+        """Drop the estimates of the keys starting with ``prefix`` (a step redone)."""
+        self.estimates[:] = [e for e in self.estimates if not e.key.startswith(prefix)]
+
     def step(self, name: str, runs: Sequence[ClassifiedRun], missing: str,
              action: Callable[[], None]) -> None:
         """Run one step on ``runs``; skipped (and said) without them, reported if it fails."""
@@ -187,10 +191,10 @@ def _friction_step(state: _Calibration, runs: Sequence[ClassifiedRun],
     if implausible:  # the samples' slips are misread: keep the model's curve, the stops tell
         state.problems.append(f"friction curve: the direct fit is no tyre's curve "
                               f"({implausible}); the model's curve kept or refined")
-        state.estimates[:] = [e for e in state.estimates if not e.key.startswith("friction.")]
+        state.forget("friction.")
         state.params = state.params.replace({k: before.number(k) for k in FRICTION_KEYS},
                                             "the model's friction curve")
     state.say("refining the friction curve on the braking runs (output error)")
     refined = refine_friction(runs, _refinement_start(state.params, before), jackknife)
-    state.estimates[:] = [e for e in state.estimates if not e.key.startswith("friction.")]
+    state.forget("friction.")
     state.adopt(refined)

@@ -145,8 +145,13 @@ def _better(first: Scored | None, second: Scored | None,
         if not both:
             return not s.finding.accepted, 0, s.finding.delta_bic or 0.0
         held_out = s.finding.held_out if s.finding.held_out is not None else math.inf
-        return False, len(violations(check_campaign(runs, s.fit.params))), held_out
+        return False, _violated_under(s, runs), held_out
     return min(first, second, key=rank)
+
+
+def _violated_under(scored: Scored, runs: Sequence[ClassifiedRun]) -> int:
+    """How many relations the model ``scored`` fitted leaves violated."""
+    return len(violations(check_campaign(runs, scored.fit.params)))
 
 
 def rival(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: RigParameters,
@@ -174,8 +179,7 @@ def beats(rival: Scored, winners: Sequence[Scored], runs: Sequence[ClassifiedRun
     if rival.finding.held_out is None or best.finding.held_out is None \
             or rival.finding.held_out >= best.finding.held_out:
         return False
-    left = len(violations(check_campaign(runs, best.fit.params)))
-    return len(violations(check_campaign(runs, rival.fit.params))) < left
+    return _violated_under(rival, runs) < _violated_under(best, runs)
 
 
 def _score_discovered(candidate: Candidate, runs: Sequence[ClassifiedRun],

@@ -42,6 +42,7 @@ from landing_gear_sim.diagnosis.consistency import (
     free_rolling_excess,
 )
 from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.quantities import reference_load_n
 from landing_gear_sim.model.sensors import RUNOUT_KEYS
 from msg_tools.units import PA_PER_BAR
 
@@ -291,8 +292,7 @@ def term_formula(candidate: Candidate, params: RigParameters) -> str:
         return f"ω_read(t) = ω(t − {1e3 * params.number(SKEW_KEY):.1f} ms)"
     if LOAD_KEY in candidate.keys:
         per_kn = 1e5 * params.number(LOAD_KEY)
-        reference = params.number("friction.reference_load_n") or params.number(
-            "loading.static_load_n")
+        reference = reference_load_n(params)
         return (f"μ = μ_B(λ)·(1 {'−' if per_kn >= 0 else '+'} {abs(per_kn):.3f} %/kN·(F_z − "
                 f"{reference / 1e3:.1f} kN))")
     if BACKLASH_KEY in candidate.keys:

@@ -82,9 +82,16 @@ STATIC_LOAD = "loading.static_load_n"
 REFERENCE_LOAD = "friction.reference_load_n"
 
 
+def reference_load_n(params: RigParameters) -> float:
+    """F_ref, the vertical load at which the friction curve holds [N] (0 in the file: the
+    static load; the plant's :func:`~landing_gear_sim.model.elements.load_factor` reads it
+    the same way)."""
+    return params.number(REFERENCE_LOAD) or params.number(STATIC_LOAD)
+
+
 def at_static_load(params: RigParameters, static_load_n: float,
                    source: str = "static load") -> RigParameters:
     """The set with the loading device at ``static_load_n`` [N]: the friction curve's
     reference load stays where it was (a tyre's load sensitivity acts between the two)."""
-    reference = params.number(REFERENCE_LOAD) or params.number(STATIC_LOAD)
-    return params.replace({STATIC_LOAD: static_load_n, REFERENCE_LOAD: reference}, source)
+    return params.replace({STATIC_LOAD: static_load_n,
+                           REFERENCE_LOAD: reference_load_n(params)}, source)

@@ -19,7 +19,8 @@ from .checks import BRAKING_PRESSURE_PA, CONTACT_LOAD_N
 from .run import SIGNALS, Run
 
 MAX_STAMP_NOISE = 0.3  # of a period: stamps within this of the fitted grid are on it
-MAX_INTERPOLATED_GAP = 5  # missing samples bridged by interpolation; longer gaps split a run
+MAX_INTERPOLATED_GAP = 5  # missing samples bridged by interpolation ...
+MAX_BRIDGED_GAP_S = 0.1  # ... or a logger's dropout up to this long; longer gaps split a run
 MIN_PART_S = 1.0  # a part of a split run shorter than this carries too little to keep
 PART = "__part"  # a split run's parts are named <run>__part1, <run>__part2, ...
 
@@ -62,6 +63,20 @@ def fixed_rate_clock(time_s: np.ndarray) -> Clock | None:
     return Clock(float(start), float(period), index.astype(np.int64))
 
 
+def bridgeable(clock: Clock) -> int:
+    """The most samples a gap on ``clock`` may miss to be bridged by interpolation (a
+    logger's dropout of 50 ms once split every run of a campaign, and the parts that began
+    mid-stop were lost)."""
+    return max(MAX_INTERPOLATED_GAP, int(MAX_BRIDGED_GAP_S / clock.period_s + 1e-9))
+
+
+def bridged_samples(clock: Clock) -> np.ndarray:
+    """The samples of ``clock``'s grid that no row holds (mask, one per grid instant)."""
+    missing = np.ones(int(clock.index[-1]) + 1, dtype=bool)
+    missing[clock.index] = False
+    return missing
+
+
 def gap_text(time_s: np.ndarray, clock: Clock, row: int) -> str:
     """The gap before ``row`` in words: how long, after which time."""
     return (f"{clock.missing[row] * clock.period_s:.4g} s missing after "
@@ -82,8 +97,9 @@ class Split:
 
 
 def split_at_gaps(run: Run) -> Split:
-    """``run`` as it is, or its parts between gaps of more than MAX_INTERPOLATED_GAP missing
-    samples; short gaps are noted (they are interpolated where a uniform grid is needed).
+    """``run`` as it is, or its parts between gaps too long to bridge (:func:`bridgeable`);
+    short gaps are noted (they are interpolated where a uniform grid is needed, and left
+    out of every comparison with a simulation).
 
     A part that begins while the brake acts on the loaded wheel is left out: a simulation
     cannot start mid-stop from the measured state. So is a part shorter than MIN_PART_S.
@@ -91,11 +107,12 @@ def split_at_gaps(run: Run) -> Split:
     clock = fixed_rate_clock(run.time_s)
     if clock is None:
         return Split((run,), ())
-    missing = clock.missing
-    notes = [f"{run.name}: {int(np.sum((missing > 0) & (missing <= MAX_INTERPOLATED_GAP)))} "
-             f"short gap(s) of ≤ {MAX_INTERPOLATED_GAP} samples, interpolated"] \
-        if np.any((missing > 0) & (missing <= MAX_INTERPOLATED_GAP)) else []
-    cuts = np.flatnonzero(missing > MAX_INTERPOLATED_GAP)
+    missing, limit = clock.missing, bridgeable(clock)
+    short = (missing > 0) & (missing <= limit)
+    notes = [f"{run.name}: {int(np.sum(short))} short gap(s) of ≤ {limit} samples "
+             f"({limit * clock.period_s:.3g} s, {int(np.sum(missing[short]))} samples in all), "
+             "interpolated and left out of the comparisons"] if np.any(short) else []
+    cuts = np.flatnonzero(missing > limit)
     if not cuts.size:
         return Split((run,), tuple(notes))
     notes.extend(f"{run.name}: {gap_text(run.time_s, clock, int(k))}; the run is split there"

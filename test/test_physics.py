@@ -130,7 +130,7 @@ def test_stepping_the_blocks_one_by_one_equals_the_compiled_run(reference, conta
     p, h = reference.vector(), scenario.step_s
     matrices = actuator.actuator_matrices(p, h)
     expected = np.empty((current.size, plant.N_CHANNELS))
-    run_kernel(p, matrices, current, h, contact, speed_m_s, 0.0, expected)
+    run_kernel(p, matrices, current, h, contact, speed_m_s, 0.0, np.zeros(0), expected)
 
     x, xa, xl = np.zeros(plant.N_STATES), actuator.actuator_state(matrices), np.zeros(1)
     x[plant.SPEED] = speed_m_s

@@ -88,8 +88,10 @@ def test_broken_time_base_is_named(tmp_path, csv_file, edit, fragment):
 
 
 def test_a_lone_run_with_a_long_gap_is_read_but_not_bridged(tmp_path, csv_file):
-    """Gaps are data: converting keeps them; a tool that needs one sample period says why it
-    cannot use the run (a campaign reader splits it, test_identify)."""
+    """Gaps are data: converting keeps them; a tool that needs one sample period bridges a
+    logger's dropout of up to 0.1 s (interpolated, and not compared with a simulation) and
+    says why it cannot use a run with a longer one (a campaign reader splits it,
+    test_identify)."""
     from landing_gear_sim.calibration.runs import classified
 
     lines = csv_file.read_text().splitlines()
@@ -97,8 +99,13 @@ def test_a_lone_run_with_a_long_gap_is_read_but_not_bridged(tmp_path, csv_file):
     gappy.write_text("\n".join([lines[0], *lines[1:101], *lines[151:]]) + "\n")
     run = read_csv(gappy)
     assert len(run) == len(lines) - 51
-    with pytest.raises(RunFormatError, match=r"gappy: 0.05 s missing after t = .*too long"):
-        classified(run)
+    bridged = classified(run)
+    assert len(bridged) == len(lines) - 1 and bridged.bridged.sum() == 50
+    assert not bridged.compared[100:150].any() and bridged.compared[:100].all()
+    longer = tmp_path / "longer.csv"
+    longer.write_text("\n".join([lines[0], *lines[1:101], *lines[251:]]) + "\n")
+    with pytest.raises(RunFormatError, match=r"longer: 0.15 s missing after t = .*too long"):
+        classified(read_csv(longer))
 
 
 def test_bag_missing_a_topic_is_named(tmp_path, run):

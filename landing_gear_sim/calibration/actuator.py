@@ -94,13 +94,14 @@ def fit_actuator_dynamics(runs: Sequence[Run], p: RigParameters
 
     frf_fit = least_squares(frf_residual, [1.0, zeta0], bounds=([0.1, 0.05], [10.0, 3.0]))
     f_frf, zeta_frf = frf_fit.x[0] * f0, frf_fit.x[1]
-    measured = SensorModel.of(p).true_pressure(run.pressure_pa)
+    sensors = SensorModel.of(p)  # the model's pressure as its channel reads it (a late one)
     held = logged_to_held(run.current_a)
 
     def time_residual(theta: np.ndarray) -> np.ndarray:
         trial = p.replace({"actuator.natural_frequency_hz": theta[0] / (2 * math.pi),
                            "actuator.damping_ratio": theta[1]})
-        return (actuator_pressure(trial, held, run.rate_hz) - measured) / PA_PER_BAR
+        read = sensors.pressure_channel(run.time_s, actuator_pressure(trial, held, run.rate_hz))
+        return (read - run.pressure_pa) / PA_PER_BAR
 
     wn_frf = 2 * math.pi * f_frf
     fit = least_squares(time_residual, [wn_frf, zeta_frf], x_scale=[wn_frf, 0.1],

@@ -21,7 +21,7 @@ from landing_gear_sim.calibration.statistics import (
     run_weights,
 )
 from landing_gear_sim.errors import IdentificationError
-from landing_gear_sim.model.elements import fade_factor
+from landing_gear_sim.model.elements import brake_torques, fade_factor, slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s, rolling_radius_at
 from landing_gear_sim.model.sensors import SensorModel
@@ -74,6 +74,11 @@ def prepare(run: ClassifiedRun, p: RigParameters) -> Braking:
                                                 run.vertical_load_n), rate),
         start_s=run.brake_start_s - float(run.time_s[0]),
     )
+
+
+def slip(b: Braking, p: RigParameters) -> np.ndarray:
+    """The slip of the filtered signals (the unloaded radius), (n,)."""
+    return slip_ratio(b.speed_m_s, b.wheel, p.number("wheel.unloaded_radius_m"))
 
 
 def free_rolling(b: Braking) -> np.ndarray:
@@ -161,6 +166,28 @@ def torque_balance(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray
     return torque, np.cumsum(power * dt)
 
 
+def model_torque(b: Braking, p: RigParameters, energy: np.ndarray, mask: np.ndarray
+                 ) -> np.ndarray:
+    """The brake torque the model ``p`` gives the samples ``mask`` of ``b`` [N m]: its whole
+    gain law (fade at the absorbed ``energy``, slopes in speed and pressure, the run's drift),
+    through the plant's own law; a disc's run-out left out (it averages out over a
+    revolution; :mod:`~landing_gear_sim.calibration.wheel_angle` reads it)."""
+    pressure = np.ascontiguousarray(b.pressure[mask])
+    torque = brake_torques(_without_runout(p).vector(), pressure,
+                           np.ascontiguousarray(energy[mask]),
+                           np.ascontiguousarray(b.wheel[mask]), np.zeros_like(pressure))
+    return torque * (1.0 + p.number("brake.gain_drift_per_run") * b.run.campaign_order)
+
+
+RUNOUT_AMPLITUDES = ("brake.runout_1", "brake.runout_2")
+
+
+def _without_runout(p: RigParameters) -> RigParameters:
+    if all(p.number(k) == 0.0 for k in RUNOUT_AMPLITUDES):
+        return p
+    return p.replace(dict.fromkeys(RUNOUT_AMPLITUDES, 0.0), "run-out left out")
+
+
 def braking_samples(b: Braking) -> np.ndarray:
     """Samples where the torque balance measures the brake (mask (n,)): braking settled,
     pressure over 3 bar, the wheel turning and loaded."""
@@ -177,8 +204,9 @@ def steady_braking_samples(b: Braking) -> np.ndarray:
 def fit_brake_gain(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
     """k_b from the wheel torque balance r F_x − J_w ω̇ = k_b P (least squares).
 
-    When the model has brake fade, k_b, φ and E_f of k_b (1 − φ(1 − e^{−E/E_f})) P are
-    fitted together, E the energy absorbed so far (measured by the same balance).
+    When the model has brake fade, k_b, φ, E_f and the shape s of k_b (1 − φ g(E/E_f)) P
+    (:func:`~landing_gear_sim.model.elements.fade_factor`) are fitted together, E the energy
+    absorbed so far (measured by the same balance).
     """
     torque, pressure, energy = [], [], []
     for b in runs:
@@ -196,20 +224,24 @@ def fit_brake_gain(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
         gain = float(pr @ t / (pr @ pr))
         gain_std = float(linear_std(pr[:, None], t - gain * pr, 1)[0])
         return [Estimate("brake.gain_n_m_per_pa", gain, gain_std, names, "wheel torque balance")]
-    keys = ("brake.gain_n_m_per_pa", "brake.fade_fraction", "brake.fade_energy_j")
+    keys = ("brake.gain_n_m_per_pa", "brake.fade_fraction", "brake.fade_energy_j",
+            "brake.fade_shape")
 
     def residual(theta: np.ndarray) -> np.ndarray:
-        gain, fraction, log_energy = theta
-        fade = fade_factor(fraction, e, math.exp(log_energy))
+        gain, fraction, log_energy, shape = theta
+        fade = fade_factor(fraction, e, math.exp(log_energy), shape)
         return (gain * GAIN_UNIT * fade * pr - t) / TORQUE_UNIT_N_M
 
     start = [p.number(keys[0]) / GAIN_UNIT, p.number(keys[1]), math.log(p.number(keys[2]))]
-    fit = least_squares(residual, start, bounds=([1e-3, 0.0, math.log(1e3)],
-                                                 [1e2, 0.95, math.log(1e9)]))
-    std = covariance_std(fit, 3)
-    k_b, fraction, log_energy = fit.x
+    bounds = ([1e-3, 0.0, math.log(1e3), 0.0], [1e2, 0.95, math.log(1e9), 1.0])
+    # the shape's two ends: a fade's first slope fits either, its bend tells them apart
+    fit = min((least_squares(residual, [*start, shape], bounds=bounds) for shape in (0.0, 1.0)),
+              key=lambda f: f.cost)
+    std = covariance_std(fit, len(keys))
+    k_b, fraction, log_energy, shape = fit.x
     method = "wheel torque balance with fade"
     return [Estimate(keys[0], k_b * GAIN_UNIT, std[0] * GAIN_UNIT, names, method),
             Estimate(keys[1], fraction, std[1], names, method),
             Estimate(keys[2], math.exp(log_energy), math.exp(log_energy) * std[2], names,
-                     method)]
+                     method),
+            Estimate(keys[3], shape, std[3], names, method)]

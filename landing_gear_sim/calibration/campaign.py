@@ -13,7 +13,9 @@ from pathlib import Path
 
 import numpy as np
 
+from landing_gear_sim.calibration.logger import Logger
 from landing_gear_sim.calibration.measured import run_parameters
+from landing_gear_sim.calibration.wheel_angle import BRAKE_RUNOUT_KEYS, has_brake_runout
 from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import RigParameters
@@ -83,14 +85,13 @@ def _campaign_order(braking: Sequence[str]) -> dict[str, float]:
 
 def _start_angle(params: RigParameters, rng: np.random.Generator) -> RigParameters:
     """A run starts with the wheel at an angle of its own: an encoder's ripple with the
-    angle (run-out) has a phase of its own in each run."""
-    sensors = SensorModel.of(params)
-    if not sensors.ripples:
+    angle and a disc's run-out have a phase of their own in each run."""
+    if not (SensorModel.of(params).ripples or has_brake_runout(params)):
         return params
     start = rng.uniform(0.0, 2.0 * np.pi)
-    _, phase1, _, phase2 = sensors.runout
-    return params.replace({RUNOUT_KEYS[1]: phase1 + start, RUNOUT_KEYS[3]: phase2 + 2 * start},
-                          "the run's start angle")
+    phases = {key: params.number(key) + order * start for order, key in
+              zip((1, 2, 1, 2), (*RUNOUT_KEYS[1::2], *BRAKE_RUNOUT_KEYS[1::2]), strict=True)}
+    return params.replace(phases, "the run's start angle")
 
 
 def _light(params: RigParameters) -> RigParameters:
@@ -105,12 +106,19 @@ def _loaded(params: RigParameters, name: str) -> RigParameters:
 
 
 def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,
-                      names: Sequence[str] | None = None, light: bool = False) -> list[Path]:
+                      names: Sequence[str] | None = None, light: bool = False,
+                      logger: Logger | None = None) -> list[Path]:
     """Simulate and write the standard runs of ``rig`` (or those in ``names``), with
-    ``light`` the light stops too (see LIGHT_BAR), into ``folder``; returns the CSV paths."""
+    ``light`` the light stops too (see LIGHT_BAR), into ``folder``, as ``logger`` writes
+    them (default: at the rig's output rate, nothing beyond the sensors' noise); returns
+    the CSV paths."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
+    logger = logger or Logger()
     written = []
+    rig.to_yaml(folder / GENERATING_FILE)
+    if logger.rate_hz is not None:
+        rig = rig.replace({"simulation.output_rate_hz": logger.rate_hz}, "the logger's rate")
     scenarios = standard_scenarios(rig, light)
     order = _campaign_order([n for n, s in scenarios.items() if s.contact
                              and (names is None or n in names)])
@@ -119,9 +127,10 @@ def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,
             continue
         params = _start_angle(_loaded(run_parameters(rig, order.get(name, 0.0)), name),
                               np.random.default_rng([seed, i]))
-        run = simulate(params, scenario).to_run(noise=seed * 100 + i)
+        result = simulate(params, scenario)
+        run = logger.write(result, result.to_run(noise=seed * 100 + i),
+                           np.random.default_rng([seed, i, 1]))
         path = folder / f"{name}.csv"
         write_csv(run, path)
         written.append(path)
-    rig.to_yaml(folder / GENERATING_FILE)
     return written

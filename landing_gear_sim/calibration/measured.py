@@ -13,7 +13,13 @@ from collections.abc import Sequence
 import numpy as np
 
 from landing_gear_sim.calibration.runs import ClassifiedRun, classified
-from landing_gear_sim.calibration.wheel_angle import free_rolling, measured_angle_rad, run_phases
+from landing_gear_sim.calibration.wheel_angle import (
+    brake_run_phases,
+    free_rolling,
+    has_brake_runout,
+    measured_angle_rad,
+    run_phases,
+)
 from landing_gear_sim.model.integrate import SimulationResult, simulate
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import at_static_load, rim_speed_m_s
@@ -42,14 +48,16 @@ def channels_of(run: ClassifiedRun) -> tuple[str, ...]:
     return tuple(CHANNELS) if run.braking else ACTUATOR_CHANNELS
 
 
-def scenario_for_run(run: ClassifiedRun, params: RigParameters) -> Scenario:
-    """The measured run's input as a scenario: its current, its initial speed, its timing."""
+def scenario_for_run(run: ClassifiedRun, params: RigParameters,
+                     wheel_angle_rad: np.ndarray | None = None) -> Scenario:
+    """The measured run's input as a scenario: its current, its initial speed, its timing
+    (and the wheel's measured angle, for a disc's run-out, when given)."""
     initial = float(np.mean(rim_speed_m_s(params, run.flywheel_speed_rad_s[
         :INITIAL_SPEED_SAMPLES])))
     contact = run.braking
     return Scenario(run.name, logged_to_held(run.command_a), run.rate_hz, contact,
                     initial if contact else 0.0, LOWEST_SIM_SPEED_M_S if contact else 0.0,
-                    "measured input")
+                    "measured input", wheel_angle_rad=wheel_angle_rad)
 
 
 GAIN = "brake.gain_n_m_per_pa"
@@ -96,18 +104,22 @@ def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult
 
     If the model stops (speed below 1 m/s) before the measurement ends, the last
     simulated sample is held, so both have the same length, except the pressure: the
-    valve goes on following the measured current. The touch-down time is the run's
+    valve goes on following the measured current; where the logger lost samples (see
+    ClassifiedRun.compared) it holds the measurement, so nothing compares them. The
+    touch-down time is the run's
     start, as in the rig procedure; the loading device holds the run's own static load. A
-    wheel encoder that ripples with the wheel's angle
-    ripples at the measured angle, with the run's own phase (see
+    wheel encoder that ripples with the wheel's angle, and a disc's run-out, act at the
+    measured angle, with the run's own phase (see
     :mod:`~landing_gear_sim.calibration.wheel_angle`).
     """
     run = classified(run)
     params = _at_run_load(run_parameters(params, run.campaign_order), run)
-    angle = None
+    angle = followed = None
     if run.braking and SensorModel.of(params).ripples:
         params, angle = run_phases(params, run), measured_angle_rad(run)
-    result = simulate(params, scenario_for_run(run, params))
+    if run.braking and has_brake_runout(params):
+        params, followed = brake_run_phases(params, run), measured_angle_rad(run)
+    result = simulate(params, scenario_for_run(run, params, followed))
     simulated = result.to_run(
         wheel_angle_rad=None if angle is None else angle[:len(result.time_s)])
     n, m = len(run), len(simulated)
@@ -115,6 +127,10 @@ def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult
     fields = {name: getattr(simulated, name)[take] for name in CHANNELS}
     if m < n:
         fields["pressure_pa"] = result.sensed_pressure_to_end()[:n]
+    if run.bridged is not None:  # not compared where the logger lost the rig
+        lost = ~run.compared
+        fields = {name: np.where(lost, getattr(run, name), values)
+                  for name, values in fields.items()}
     return Run(name=run.name, source="simulation", time_s=run.time_s,
                current_a=run.current_a, **fields), result
 

@@ -26,7 +26,13 @@ from landing_gear_sim.model.scenario import brake_start_index, current_noise_a, 
 from msg_tools.errors import RunFormatError
 from msg_tools.io import is_uniform, resample
 from msg_tools.run import Run
-from msg_tools.timebase import MAX_INTERPOLATED_GAP, fixed_rate_clock, gap_text, on_clock
+from msg_tools.timebase import (
+    bridgeable,
+    bridged_samples,
+    fixed_rate_clock,
+    gap_text,
+    on_clock,
+)
 
 STILL_FLYWHEEL_RAD_S = 1.0  # an actuator-only run: the flywheel stands still ...
 NO_CONTACT_LOAD_N = 2e3  # ... and the wheel carries (almost) no load
@@ -37,6 +43,7 @@ CONSTANT_STD_A = 5e-3  # a braking run whose current varies less than this is co
 CONSTANT_NOISE_FACTOR = 3.0  # ... or less than this many σ of its logging noise
 SETTLE_S = 0.3  # after the braking start the current has settled
 UNIFORM_TOLERANCE = 1e-3  # of a period: steps closer than this count as evenly spaced
+SETTLE_AFTER_GAP_S = 0.2
 
 
 class Family(enum.Enum):
@@ -97,13 +104,29 @@ class ClassifiedRun(Run):
     """Place among the campaign's braking runs in run order, about the middle one
     (−1, 0, 1 for three); 0 for a run classified on its own or one that does not brake."""
 
+    bridged: np.ndarray | None = dataclasses.field(kw_only=True, default=None)
+    """Samples a logger lost and the uniform grid interpolated (mask (n,)), None when none:
+    a simulation of the run is not compared there (:func:`compared`)."""
+
     @classmethod
     def of(cls, run: Run) -> ClassifiedRun:
         """``run`` on a uniform time base, classified."""
+        bridged = _bridged(run)
         run = on_uniform_grid(run)
         fields = {f.name: getattr(run, f.name) for f in dataclasses.fields(Run)}
         start = brake_start_s(run)
-        return cls(**fields, kind=classify(run, start), brake_start_s=start)
+        return cls(**fields, kind=classify(run, start), brake_start_s=start, bridged=bridged)
+
+    @property
+    def compared(self) -> np.ndarray:
+        """The samples a simulation is compared on (mask (n,)): all but those the logger lost
+        and SETTLE_AFTER_GAP_S after each (a simulation fed the held current through a gap
+        takes that long to follow the rig again)."""
+        if self.bridged is None:
+            return np.ones(len(self), dtype=bool)
+        after = max(1, round(SETTLE_AFTER_GAP_S * self.rate_hz))
+        lost = np.convolve(self.bridged, np.ones(after + 1), mode="full")[:len(self)] > 0
+        return ~lost
 
     @property
     def braking(self) -> bool:
@@ -133,12 +156,22 @@ def on_uniform_grid(run: Run) -> Run:
     if clock is None:
         return resample(run, round(run.rate_hz))
     missing = clock.missing
-    if missing.max() > MAX_INTERPOLATED_GAP:
+    if missing.max() > bridgeable(clock):
         raise RunFormatError(f"{run.name}: {gap_text(run.time_s, clock, int(np.argmax(missing)))}"
                              ", too long to interpolate; read it as part of a campaign to "
                              "have it split there")
     run = on_clock(run, clock)
     return resample(run, 1.0 / clock.period_s) if missing.max() else run
+
+
+def _bridged(run: Run) -> np.ndarray | None:
+    """The samples of ``run``'s uniform grid that no row holds, None when it has no gap."""
+    if is_uniform(run, UNIFORM_TOLERANCE):
+        return None
+    clock = fixed_rate_clock(run.time_s)
+    if clock is None or not clock.missing.max():
+        return None
+    return bridged_samples(clock)
 
 
 def classified(run: Run) -> ClassifiedRun:

@@ -1,5 +1,6 @@
-"""The wheel encoder's ripple with the wheel's angle, read from a measured run (issue 14,
-the ``wheel_angle`` family: run-out, an out-of-round or oval code wheel).
+"""Ripples with the wheel's angle, read from a measured run (issue 14, the ``wheel_angle``
+family): the wheel encoder's (run-out, an out-of-round or oval code wheel) and the brake
+torque's (a disc's run-out or thickness variation).
 
 A ripple once or twice per revolution chirps with the wheel's speed, so it is fitted in the
 angle domain: the reading against cos(mθ), sin(mθ), θ the measured angle (the trapezoid
@@ -8,19 +9,29 @@ the wheel's speed is smooth in time (a quadratic trend takes the flywheel's slow
 A run starts with the wheel at an angle of its own, so each run has its own phase: a
 simulation of a measured run takes the phase from the run and the ripple's size from the
 model (:func:`run_phases`).
+
+The brake's ripple is read the same way from the wheel's torque balance while it brakes:
+the brake torque r F_x − J_w ω̇ over the model's torque law (its own run-out left out),
+against cos(mθ), sin(mθ) with a quadratic trend in time, on signals low-passed at
+RIPPLE_FILTER_HZ (a ripple once per revolution is at 30 Hz at 60 m/s: the 20 Hz filter of
+the calibration's torque balance would take it out). An encoder that ripples makes ω̇
+ripple too: the model's encoder ripple is taken off the wheel channel first.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.statistics import linear_std
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.model.sensors import RUNOUT_KEYS, wheel_angle_rad
+from landing_gear_sim.model.quantities import rolling_radius_at
+from landing_gear_sim.model.sensors import RUNOUT_KEYS, SensorModel, wheel_angle_rad
 
 ORDERS = (1, 2)  # ripples per revolution
 LOADED_N = 5e3  # the wheel is on the flywheel
@@ -28,6 +39,11 @@ BEFORE_BRAKE_S = (1.0, 0.05)  # free rolling: from 1 s to 50 ms before the brake
 MIN_SPEED_RAD_S = 20.0  # slower, a revolution outlasts the window's trend
 MIN_SAMPLES = 200
 TREND = 3  # columns of the quadratic trend in time
+BRAKE_RUNOUT_KEYS = ("brake.runout_1", "brake.runout_1_phase_rad", "brake.runout_2",
+                     "brake.runout_2_phase_rad")  # amplitudes: br.RUNOUT_AMPLITUDES
+RIPPLE_FILTER_HZ = 150.0
+NYQUIST_SHARE = 0.8  # a slower log: low-passed at this share of its Nyquist frequency
+MAX_SLIP = 0.15  # beyond, a wheel on its way to lock: the torque balance's error dominates
 
 
 @dataclass(frozen=True)
@@ -72,14 +88,7 @@ def angle_ripple(run: ClassifiedRun) -> AngleRipple | None:
     fitted = ripple_design(run)
     if fitted is None:
         return None
-    y, design = fitted
-    coef, *_ = np.linalg.lstsq(design, y, rcond=None)
-    std = linear_std(design, y - design @ coef, design.shape[1])
-    pairs = [(coef[TREND + 2 * i], coef[TREND + 2 * i + 1]) for i in range(len(ORDERS))]
-    return AngleRipple(tuple(math.hypot(c, s) for c, s in pairs),
-                       tuple(math.atan2(-s, c) for c, s in pairs),
-                       tuple(float(max(std[TREND + 2 * i], std[TREND + 2 * i + 1]))
-                             for i in range(len(ORDERS))))
+    return _fit(*fitted)
 
 
 def run_phases(params: RigParameters, run: ClassifiedRun) -> RigParameters:
@@ -90,3 +99,81 @@ def run_phases(params: RigParameters, run: ClassifiedRun) -> RigParameters:
         return params
     return params.replace({RUNOUT_KEYS[1]: ripple.phase_rad[0],
                            RUNOUT_KEYS[3]: ripple.phase_rad[1]}, "the run's start angle")
+
+
+def _fit(y: np.ndarray, design: np.ndarray) -> AngleRipple:
+    coef, *_ = np.linalg.lstsq(design, y, rcond=None)
+    std = linear_std(design, y - design @ coef, design.shape[1])
+    pairs = [(coef[TREND + 2 * i], coef[TREND + 2 * i + 1]) for i in range(len(ORDERS))]
+    return AngleRipple(tuple(math.hypot(c, s) for c, s in pairs),
+                       tuple(math.atan2(-s, c) for c, s in pairs),
+                       tuple(float(max(std[TREND + 2 * i], std[TREND + 2 * i + 1]))
+                             for i in range(len(ORDERS))))
+
+
+def has_brake_runout(params: RigParameters) -> bool:
+    return any(params.number(k) != 0.0 for k in br.RUNOUT_AMPLITUDES)
+
+
+def brake_ripple_design(run: ClassifiedRun, params: RigParameters,
+                        prepared: br.Braking | None = None
+                        ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The brake torque of ``run``'s torque balance over the model's (its run-out left out),
+    minus 1, where the brake acts on a wheel away from lock, (m,), and the regressors
+    (quadratic trend, then cos(mθ), sin(mθ) per order), (m, TREND + 2·len(ORDERS)); None
+    when the run does not brake long enough (``prepared``: its filtered signals, if at hand)."""
+    if not run.braking:
+        return None
+    b = prepared or br.prepare(run, params)
+    angle = measured_angle_rad(run)
+    sensors = SensorModel.of(params)
+    wheel = run.wheel_speed_rad_s
+    if sensors.ripples:  # the model's encoder ripple off the wheel channel first
+        wheel = wheel / sensors.encoder(np.ones_like(angle), angle)
+    rate = run.rate_hz
+    cutoff = min(RIPPLE_FILTER_HZ, NYQUIST_SHARE * rate / 2)
+    wheel = br.lowpass(wheel, rate, cutoff)
+    force = br.lowpass(sensors.true_longitudinal(run.longitudinal_force_n, run.vertical_load_n),
+                       rate, cutoff)
+    torque = rolling_radius_at(params, b.load) * force - params.number(
+        "wheel.inertia_kg_m2") * np.gradient(wheel, 1.0 / rate)
+    _, energy = br.torque_balance(b, params)
+    mask = br.braking_samples(b) & (wheel > MIN_SPEED_RAD_S) & (br.slip(b, params) < MAX_SLIP)
+    if mask.sum() < MIN_SAMPLES:
+        return None
+    m = np.flatnonzero(mask)
+    law = br.model_torque(dataclasses.replace(b, wheel=wheel), params, energy, m)
+    t = run.time_s[m] - run.time_s[m].mean()
+    waves = [f(order * angle[m]) for order in ORDERS for f in (np.cos, np.sin)]
+    return torque[m] / law - 1.0, np.column_stack([np.ones_like(t), t, t * t, *waves])
+
+
+def brake_ripple(run: ClassifiedRun, params: RigParameters,
+                 prepared: br.Braking | None = None) -> AngleRipple | None:
+    """The brake torque's ripple with the wheel's angle in ``run`` per order, or None."""
+    fitted = brake_ripple_design(run, params, prepared)
+    return None if fitted is None else _fit(*fitted)
+
+
+def brake_run_phases(params: RigParameters, run: ClassifiedRun) -> RigParameters:
+    """``params`` with the brake ripple's phases of ``run`` (its own start angle), when the
+    run shows where it is. The phases do not depend on the ripple's size, so a fit of the
+    size reads them once per run (:data:`_PHASES`)."""
+    key = (id(run), params.replace(dict.fromkeys(BRAKE_RUNOUT_KEYS, 0.0), "key").vector()
+           .tobytes())
+    if key not in _PHASES:
+        ripple = brake_ripple(run, params)
+        if len(_PHASES) >= PHASES_KEPT:
+            _PHASES.pop(next(iter(_PHASES)))
+        _PHASES[key] = (run, None if ripple is None else ripple.phase_rad)
+    phases = _PHASES[key][1]
+    if phases is None:
+        return params
+    return params.replace({BRAKE_RUNOUT_KEYS[1]: phases[0], BRAKE_RUNOUT_KEYS[3]: phases[1]},
+                          "the run's start angle")
+
+
+PHASES_KEPT = 64
+_PHASES: dict[tuple[int, bytes], tuple[ClassifiedRun, tuple[float, ...] | None]] = {}
+"""Phases read, by run (its id; the run kept alive with them, so the id stays its own) and
+by the model without its ripple's size."""

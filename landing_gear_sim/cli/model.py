@@ -91,6 +91,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     gen.add_argument("--seed", type=int, default=1)
     gen.add_argument("--deviation", type=float, default=0.03,
                      help="largest relative deviation of the rig from the datasheet")
+    gen.add_argument("--logger", default="", metavar="KEY=VALUE,...",
+                     help="log as a real logger does (the logger realities the diagnosis must "
+                          "see through): rate_hz, encoder_counts (lines per revolution), "
+                          "current_noise_a, current_adc_bits, current_range_a, "
+                          "late=CHANNEL:SECONDS, dropout_s; e.g. rate_hz=200,encoder_counts=64")
     gen.add_argument("--light-runs", action="store_true",
                      help="also brake three stops at 70 %% of the static load (14, 21, 28 bar): "
                           "what shows a tyre's friction changing with the load")
@@ -249,13 +254,17 @@ def cmd_params(args: argparse.Namespace) -> int:
 
 def cmd_campaign(args: argparse.Namespace) -> int:
     from landing_gear_sim.calibration.campaign import GENERATING_FILE, generate_campaign, rig_like
+    from landing_gear_sim.calibration.logger import Logger
 
     if args.output.exists() and any(args.output.iterdir()):
         raise LandingGearSimError(f"{args.output}: exists and is not empty, not overwriting")
+    logger = Logger.parse(args.logger)
     rig = rig_like(params_of(args), np.random.default_rng(args.seed), args.deviation)
+    realities = "".join(f", {words}" for words in logger.realities)
     progress(f"simulating a synthetic campaign (seed {args.seed}, datasheet "
-              f"±{100 * args.deviation:g} %)")
-    for path in generate_campaign(args.output, rig, args.seed, light=args.light_runs):
+              f"±{100 * args.deviation:g} %{realities})")
+    for path in generate_campaign(args.output, rig, args.seed, light=args.light_runs,
+                                  logger=logger):
         print(f"  {path}")
     print(f"generating parameters (for checks only): {args.output / GENERATING_FILE}")
     return 0

@@ -12,6 +12,7 @@ curve, the brake gain or the drag to swallow an effect the relations still show)
   depend on whether the current last rose or fell (play, hysteresis: ``input_history``);
 * in free rolling the wheel channel is smooth in the wheel's angle: no ripple once or twice
   per revolution beyond the model's (run-out, an out-of-round code wheel: ``wheel_angle``);
+  and so is the brake torque while it brakes (a disc's run-out: ``wheel_angle`` too);
 * at the same slip, μ = F_x/F_z does not depend on the load, where runs at two static
   loads share slips (a tyre's load sensitivity beyond the radius law: ``load``);
 * the brake gain of the wheel's torque balance r F_x − J_w ω̇ = k_b P does not depend on
@@ -25,6 +26,7 @@ Z_VIOLATED σ and the floor. No plotting here (:mod:`landing_gear_sim.report.dia
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -42,7 +44,12 @@ from landing_gear_sim.calibration.statistics import (
     linear_std,
     weighted_least_squares,
 )
-from landing_gear_sim.calibration.wheel_angle import ORDERS, angle_ripple
+from landing_gear_sim.calibration.wheel_angle import (
+    BRAKE_RUNOUT_KEYS,
+    ORDERS,
+    angle_ripple,
+    brake_ripple,
+)
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.scoring import effective_count
 from landing_gear_sim.model.actuator import actuator_pressure
@@ -68,11 +75,16 @@ FRICTION_IN_LOAD = "friction the same at every load"
 SLIP_KNOTS = 8  # inner knots of the free friction curve
 MIN_SLIP = 0.008  # below, a few hub-speed errors (0.01 m/s at the 3 m/s stop speed: 0.003)
 MAX_SLIP = 0.3  # beyond, a skidding wheel is on its way to lock, not on the steady curve
+MAX_BRAKING_SLIP = 0.15  # beyond, the torque balance's derivative error dominates
 LOAD_SPREAD = 0.05  # static loads closer than 5 % cannot show a law in load
 LOAD_UNIT_N = 1e4
 LOAD_FLOOR = 0.03  # μ changing by less than 3 % per 10 kN does not matter
 WHEEL_ANGLE = "wheel channel smooth in the wheel's angle"
 RUNOUT_FLOOR = 1e-3  # a ripple below 0.1 % of the wheel speed is within the encoder's noise
+PRESSURE_TIMING = "brake torque in step with the measured pressure"
+TIMING_FLOOR_S = 1e-3  # a channel out of step by less than a millisecond does not matter
+BRAKE_ANGLE = "brake torque smooth in the wheel's angle"
+BRAKE_RUNOUT_FLOOR = 0.01  # a disc's ripple below 1 % of the torque does not matter
 SLOW_A_S = 0.5  # slower current changes: A(s) errors leave no direction-locked residual
 
 
@@ -116,6 +128,7 @@ def check_campaign(runs: Sequence[ClassifiedRun], params: RigParameters) -> list
     braking = [b for b in prepared if b is not None]
     if braking:
         checks.extend(_gain_trends(braking, params))
+        checks.extend(_pressure_timing(braking, params))
         checks.extend(_friction_in_load(braking, params))
     return checks
 
@@ -138,13 +151,41 @@ def violations(checks: Sequence[Check]) -> list[Check]:
 
 def inconsistent(broken: Sequence[Check]) -> Finding:
     """Violated relations as an ``unexplained`` finding (nothing in the model explains
-    them): the strongest one's deviation, every one in the evidence."""
+    them): the strongest one's deviation, every one in the evidence, and the equation (or
+    the channel's measurement) its relation checks."""
     best = broken[0]
+    equation, channel = where(best.relation)
     return Finding("unexplained", {"deviation": best.deviation}, {"deviation": best.std},
-                   "measured relations the model cannot break are violated: "
+                   f"measured relations the model cannot break are violated, in the {equation}: "
                    + "; ".join(c.describe() for c in broken[:4])
                    + (f"; and {len(broken) - 4} more" if len(broken) > 4 else ""),
-                   {}, {}, None, None, False, tuple(sorted({c.run for c in broken})), ())
+                   {}, {}, None, None, False, tuple(sorted({c.run for c in broken})), (),
+                   equation=equation, channel=channel)
+
+
+WHERE: dict[str, tuple[str, str]] = {
+    FREE_ROLLING: ("F_x channel", "longitudinal_force_n"),
+    "zero current ⇒ zero pressure": ("pressure channel", "pressure_pa"),
+    "no contact ⇒ no load": ("load cell", "vertical_load_n"),
+    GAIN_IN_SPEED: ("wheel", "longitudinal_force_n"),
+    GAIN_IN_PRESSURE: ("wheel", "longitudinal_force_n"),
+    RUN_DRIFT: ("wheel", "longitudinal_force_n"),
+    VALVE_DIRECTION: ("valve", "pressure_pa"),
+    FRICTION_IN_LOAD: ("wheel", "longitudinal_force_n"),
+    WHEEL_ANGLE: ("wheel channel", "wheel_speed_rad_s"),
+    PRESSURE_TIMING: ("pressure channel", "pressure_pa"),
+    BRAKE_ANGLE: ("wheel", "longitudinal_force_n"),
+}
+"""The equation (or channel measurement) each relation checks, and the channel it reads it
+in (the wheel's torque balance is read in the load cell's F_x)."""
+
+
+def where(relation: str) -> tuple[str, str]:
+    """The equation a relation checks and the channel that shows it."""
+    for name, place in WHERE.items():
+        if relation.startswith(name):
+            return place
+    return "model", ""
 
 
 def _run_checks(run: ClassifiedRun, prepared: br.Braking | None, params: RigParameters
@@ -152,7 +193,8 @@ def _run_checks(run: ClassifiedRun, prepared: br.Braking | None, params: RigPara
     """The checks of one run (``prepared``: its filtered signals, for a braking run)."""
     checks = [_zero_current(run, params)]
     if prepared is not None:
-        checks.extend([_free_rolling(prepared, params), _wheel_angle(run, params)])
+        checks.extend([_free_rolling(prepared, params), _wheel_angle(run, params),
+                       _brake_angle(run, prepared, params)])
     else:
         checks.extend(_mean_check("no contact ⇒ no load", run.name, "whole run",
                                   getattr(run, name), FORCE_FLOOR_N, "N", label)
@@ -168,7 +210,7 @@ def _valve_direction(run: ClassifiedRun, params: RigParameters) -> Check | None:
     dead-band and saturation): a static map cannot tell the two apart, a valve with play
     can. Positive: more pressure on the way down."""
     model = actuator_pressure(params, logged_to_held(run.current_a), run.rate_hz)
-    residual = SensorModel.of(params).true_pressure(run.pressure_pa) - model
+    residual = run.pressure_pa - SensorModel.of(params).pressure_channel(run.time_s, model)
     change = np.diff(run.current_a, prepend=run.current_a[0])
     last = np.maximum.accumulate(np.where(change != 0.0, np.arange(change.size), 0))
     direction = np.sign(change[last])
@@ -195,6 +237,20 @@ def _wheel_angle(run: ClassifiedRun, params: RigParameters) -> Check | None:
     runout = SensorModel.of(params).runout
     checks = [Check(WHEEL_ANGLE, run.name, f"before braking, {m}× per revolution",
                     ripple.amplitude[i] - runout[2 * i], ripple.std[i], RUNOUT_FLOOR, "of ω")
+              for i, m in enumerate(ORDERS)]
+    return max(checks, key=lambda c: c.z)
+
+
+def _brake_angle(run: ClassifiedRun, prepared: br.Braking, params: RigParameters
+                 ) -> Check | None:
+    """The brake torque's strongest ripple with the wheel's angle while it brakes, beyond
+    the model's own run-out of that order [relative to T_b]."""
+    ripple = brake_ripple(run, params, prepared)
+    if ripple is None:
+        return None
+    model = [params.number(k) for k in BRAKE_RUNOUT_KEYS[::2]]
+    checks = [Check(BRAKE_ANGLE, run.name, f"braking, {m}× per revolution",
+                    ripple.amplitude[i] - model[i], ripple.std[i], BRAKE_RUNOUT_FLOOR, "of T_b")
               for i, m in enumerate(ORDERS)]
     return max(checks, key=lambda c: c.z)
 
@@ -240,17 +296,16 @@ def _gain_trends(runs: Sequence[br.Braking], params: RigParameters) -> list[Chec
     """k_b of the torque balance with a linear trend in speed, and in pressure, over the
     braking runs: the relative change over the range seen [1]."""
     torque, pressure, speed = [], [], []
-    drift = params.number("brake.gain_drift_per_run")
+    gain = params.number("brake.gain_n_m_per_pa")
     for b in runs:
-        whole, _ = br.torque_balance(b, params)
-        m = br.steady_braking_samples(b)
-        # relative to the model's own law: a gain slope or drift it has is no violation
-        whole = whole / (1.0 + params.number("brake.gain_slope_wheel_speed_s_per_rad") * b.wheel
-                         + params.number("brake.gain_slope_pressure_per_pa") * b.pressure)
-        whole = whole / (1.0 + drift * b.run.campaign_order)
-        torque.append(whole[m][::10])
-        pressure.append(b.pressure[m][::10])
-        speed.append(b.speed_m_s[m][::10])
+        whole, energy = br.torque_balance(b, params)
+        m = np.flatnonzero(br.steady_braking_samples(b))[::10]
+        # relative to the model's whole gain law: a fade, slope or drift it has is no
+        # violation (a fade the model had explained read as a gain falling with speed)
+        law = br.model_torque(b, params, energy, m) / (gain * b.pressure[m])
+        torque.append(whole[m] / law)
+        pressure.append(b.pressure[m])
+        speed.append(b.speed_m_s[m])
     t, p, v = (np.concatenate(x) for x in (torque, pressure, speed))
     if t.size < MIN_SAMPLES:
         return []
@@ -261,6 +316,36 @@ def _gain_trends(runs: Sequence[br.Braking], params: RigParameters) -> list[Chec
     if len(per_run) >= MIN_RUNS_FOR_DRIFT:
         checks.append(_run_drift(per_run))
     return checks
+
+
+def _pressure_timing(runs: Sequence[br.Braking], params: RigParameters) -> list[Check]:
+    """How late the pressure channel is against the brake torque it makes [s] (positive:
+    the channel is late), beyond the model's own delay of that channel: the torque balance's
+    T ≈ a·M + b·Ṁ, M the model's torque of the measured pressure (taken back by the model's
+    delay of the channel), so T(t) ≈ a·M(t + d), d = b/a. A valve's transport delay leaves
+    the measured pressure in step with the torque; a channel stamped late does not (an
+    actuator delay and a wheel channel 'leading' by as much were once reported together).
+    Away from lock (slip < MAX_BRAKING_SLIP), where the balance's derivative dominates."""
+    delay = SensorModel.of(params).pressure_delay_s
+    rows, columns = [], []
+    for b in runs:
+        if delay > 0.0:
+            b = dataclasses.replace(b, pressure=np.interp(b.time_s + delay, b.time_s, b.pressure))
+        torque, energy = br.torque_balance(b, params)
+        model = br.model_torque(b, params, energy, np.arange(b.time_s.size))
+        slope = np.gradient(model, 1.0 / b.run.rate_hz)
+        m = np.flatnonzero(br.braking_samples(b) & (br.slip(b, params) < MAX_BRAKING_SLIP))[::10]
+        rows.append(torque[m])
+        columns.append(np.column_stack([model[m], slope[m]]))
+    t, design = np.concatenate(rows), np.vstack(columns)
+    if t.size < MIN_SAMPLES or np.ptp(design[:, 1]) == 0.0:
+        return []
+    coef, *_ = np.linalg.lstsq(design, t, rcond=None)
+    std = linear_std(design, t - design @ coef, 2)
+    lag = float(coef[1] / coef[0])
+    lag_std = math.hypot(std[1], lag * std[0]) / abs(float(coef[0]))
+    return [Check(PRESSURE_TIMING, "campaign", f"{len(runs)} braking runs, slip < "
+                  f"{MAX_BRAKING_SLIP:g}", lag, lag_std, TIMING_FLOOR_S, "s")]
 
 
 def _friction_in_load(runs: Sequence[br.Braking], params: RigParameters) -> list[Check]:

@@ -38,6 +38,7 @@ from landing_gear_sim.diagnosis.consistency import (
     unchecked_relations,
     violations,
 )
+from landing_gear_sim.diagnosis.equations import locate_all
 from landing_gear_sim.diagnosis.findings import Finding, Signature
 from landing_gear_sim.diagnosis.identifiability import actuator_calibrated, untestable
 from landing_gear_sim.diagnosis.local import LocalGain, local_gains
@@ -53,6 +54,7 @@ from landing_gear_sim.diagnosis.signatures import (
     find_signatures,
     run_evidence,
     unexplained,
+    window_regressors,
 )
 from landing_gear_sim.errors import DiagnosisError, IdentificationError
 from landing_gear_sim.model.parameters import ELEMENTS, RigParameters
@@ -161,14 +163,6 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
                 scored.append(outcome)
         table.extend(s.finding for s in scored)
         winners = [s for s in scored if s.finding.accepted]
-        if round_ == 1 and winners:
-            rival = discovered.rival(runs, model, base, scales, before, say)
-            if rival is not None:
-                table.append(rival.finding)
-                if discovered.beats(rival, winners, runs):
-                    say(f"accepted a discovered term: {rival.finding.term}")
-                    accepted, model = [rival], rival.fit.params
-                    break
         if not winners:
             break
         best = min(winners, key=lambda s: s.finding.delta_bic or 0.0)
@@ -182,14 +176,14 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     checks = check_campaign(runs, model)
     calibrated_checks = checks if model is calibrated else check_campaign(runs, calibrated)
     problems.extend(unchecked_relations(runs, calibrated_checks))
-    if not accepted:
-        found = discovered.discover(runs, model, base, scales, before, checks, say)
-        if found is not None:
-            table.append(found.finding)
-            if found.finding.accepted:
-                accepted.append(found)
-                model = found.fit.params
-                checks = check_campaign(runs, model)
+    story = discovered.Story(runs, calibrated, base, scales, before, calibrated_checks, say)
+    found = story.extend(accepted, model, checks)
+    if found is not None:
+        table.extend(found.tried)
+        if found.scored is not None:
+            model = found.scored.fit.params
+            accepted = [*(_refreshed(s, model) for s in found.kept), found.scored]
+            checks = check_campaign(runs, model)
     say("analysing the residuals of the extended model")
     simulated_after = simulate_all(runs, model)
     after = _interpretable(find_signatures(runs, model, simulated_after), runs)
@@ -200,7 +194,9 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
                     "little held-out data for a verdict" for f in unchecked)
     if accepted or not (skipped or unchecked):
         if after:
-            findings.append(unexplained(after, baseline_fits(runs, simulated_after)))
+            places = locate_all(after, runs, model, simulated_after,
+                                lambda run, sim: window_regressors(run, sim, model))
+            findings.append(unexplained(after, baseline_fits(runs, simulated_after), places))
         if violations(checks):
             findings.append(inconsistent(violations(checks)))
         verdict = findings[0].cause if findings else "none"
@@ -311,14 +307,23 @@ def _recalibrate(runs: Sequence[ClassifiedRun], start: RigParameters, accepted: 
         # keys identify does not estimate keep their candidate-fit values (a polish on
         # all runs after the re-calibration drove the relaxation length to its bound:
         # the re-fitted friction curve had absorbed it)
+        reported = {*candidate.keys, *(key for _, key in candidate.contract)}
         std = {k: estimated[k].std if k in estimated else s.fit.std.get(k, 0.0)
-               for k in candidate.keys}
-        values = {k: model.number(k) for k in candidate.keys}
+               for k in reported}
+        values = {k: model.number(k) for k in reported}
         final = replace(s.fit, params=model, values=values, std=std)
         finding = replace(s.finding, parameters=key_parameters(candidate, model),
                           std=key_std(candidate, final))
         out.append(Scored(finding, final))
     return model, out
+
+
+def _refreshed(scored: Scored, model: RigParameters) -> Scored:
+    """A cause kept beside a discovered term, with its values in the final ``model`` (the
+    term's fit may have freed them: a delay beside a channel's skew)."""
+    candidate = scored.fit.candidate
+    return Scored(replace(scored.finding, parameters=key_parameters(candidate, model)),
+                  replace(scored.fit, params=model))
 
 
 def baseline_fits(runs: Sequence[ClassifiedRun], simulated: Sequence[Run]

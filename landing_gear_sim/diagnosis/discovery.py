@@ -25,9 +25,17 @@ import numpy as np
 import scipy.linalg
 
 from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration.identify import identify
 from landing_gear_sim.calibration.runs import ClassifiedRun
-from landing_gear_sim.calibration.wheel_angle import ORDERS, TREND, ripple_design
+from landing_gear_sim.calibration.wheel_angle import (
+    BRAKE_RUNOUT_KEYS,
+    ORDERS,
+    TREND,
+    brake_ripple,
+    ripple_design,
+)
 from landing_gear_sim.diagnosis.catalogue import (
+    ACTUATOR,
     ACTUATOR_RUNS,
     BRAKE_RUNS,
     FRICTION,
@@ -37,6 +45,7 @@ from landing_gear_sim.diagnosis.catalogue import (
     Candidate,
 )
 from landing_gear_sim.diagnosis.consistency import (
+    BRAKE_RUNOUT_FLOOR,
     FORCE_FLOOR_N,
     RUNOUT_FLOOR,
     free_rolling_excess,
@@ -174,6 +183,32 @@ def skew_candidate(lag_s: float) -> Candidate:
                      BRAKE_RUNS, WHEEL, (), (("wheel_speed_delay_s", SKEW_KEY),))
 
 
+PRESSURE_SKEW_KEY = "sensors.pressure_delay_s"
+
+
+def pressure_skew_candidate(lag_s: float, params: RigParameters) -> Candidate:
+    """The pressure channel out of step by ``lag_s`` (the torque-timing relation's reading)
+    as a candidate: fitted with the valve's dynamics (calibrated on a late reading, A(s)
+    came out slow, or a transport delay stood in for it) on the actuator runs, which pin
+    A(s), and half the braking runs, whose wheel channels show the brake's true timing;
+    checked on the other half."""
+    delay = ("actuator.delay_s",) if params.has("actuator_delay") else ()
+    return Candidate(DISCOVERED, None, (PRESSURE_SKEW_KEY,), ((min(max(lag_s, 1e-4), 0.09),),),
+                     ((0.0, 0.1),), (*ACTUATOR, *delay), (*ACTUATOR_RUNS, *BRAKE_RUNS),
+                     (*PRESSURE, *WHEEL), (), (("pressure_delay_s", PRESSURE_SKEW_KEY),))
+
+
+def pressure_skew_start(runs: Sequence[ClassifiedRun], params: RigParameters, lag_s: float
+                        ) -> RigParameters:
+    """Where a pressure skew's fit starts: ``params`` calibrated again with the channel
+    ``lag_s`` late. Calibrated on the late reading, A(s) came out slow (8.2 Hz for 12) and the
+    friction curve bent to the late brake it made: from there the fit stopped half-way (a
+    6.3 ms skew for 11.6), the true timing locking the wheel where the rig's did not."""
+    late = params.replace({PRESSURE_SKEW_KEY: lag_s}, "the pressure channel late")
+    calibration = identify(runs, late, jackknife=False)
+    return calibration.params.replace({PRESSURE_SKEW_KEY: 0.0}, "the skew to be fitted")
+
+
 BACKLASH_KEY = "actuator.backlash_a"
 BACKLASH_BOUNDS = (0.0, 0.2)  # A: a fifth of the valve's range
 
@@ -237,6 +272,33 @@ def runout_candidate(orders: dict[str, float]) -> Candidate:
                      ("wheel_speed_rad_s",), (), tuple((k.split(".")[1], k) for k in keys))
 
 
+BRAKE_RUNOUT_BOUNDS = (0.0, 0.3)  # relative: a third of the torque at most
+
+
+def select_brake_runout_orders(runs: Sequence[ClassifiedRun], params: RigParameters
+                               ) -> dict[str, float]:
+    """The orders of the brake torque's ripple with the wheel's angle that the braking runs
+    need, with the median amplitude over the runs (``brake.runout_m`` -> relative
+    amplitude), kept above the consistency floor."""
+    ripples = [r for r in (brake_ripple(run, params) for run in runs if run.braking)
+               if r is not None]
+    if not ripples:
+        return {}
+    amplitude = np.median([r.amplitude for r in ripples], axis=0)
+    return {BRAKE_RUNOUT_KEYS[2 * i]: float(a) for i, a in enumerate(amplitude)
+            if a > BRAKE_RUNOUT_FLOOR}
+
+
+def brake_runout_candidate(orders: dict[str, float]) -> Candidate:
+    """The brake torque rippling once or twice per wheel revolution (``wheel_angle``: a
+    disc's run-out) at the kept orders, each run at its own phase: fitted alone on the
+    braking runs' wheel channels."""
+    keys = tuple(orders)
+    return Candidate(DISCOVERED, None, keys, (tuple(orders.values()),),
+                     tuple(BRAKE_RUNOUT_BOUNDS for _ in keys), (), BRAKE_RUNS, WHEEL, (),
+                     tuple((f"brake_{k.split('.')[1]}", k) for k in keys))
+
+
 LOAD_KEY = "friction.load_sensitivity_per_n"
 
 
@@ -267,9 +329,9 @@ def _term_candidate(terms: Mapping[TermT, float], free: tuple[str, ...],
 
 
 def families(candidate: Candidate) -> str:
-    if set(candidate.keys) & set(RUNOUT_KEYS):
+    if set(candidate.keys) & {*RUNOUT_KEYS, *BRAKE_RUNOUT_KEYS}:
         return "wheel_angle"
-    if SKEW_KEY in candidate.keys:
+    if {SKEW_KEY, PRESSURE_SKEW_KEY} & set(candidate.keys):
         return "channel_skew"
     if LOAD_KEY in candidate.keys:
         return "load"
@@ -281,15 +343,26 @@ def families(candidate: Candidate) -> str:
                     if t.key in candidate.keys)
 
 
+def _waves(candidate: Candidate, params: RigParameters, keys: Sequence[str]) -> str:
+    """The ripple's orders among ``keys`` (amplitude, phase, ...) that ``candidate`` fits."""
+    return " + ".join(f"{100 * params.number(k):.2f} %·cos({m}θ + φ{m})" for m, k in
+                      zip(ORDERS, keys[::2], strict=True) if k in candidate.keys)
+
+
 def term_formula(candidate: Candidate, params: RigParameters) -> str:
     """The extended law with its fitted values, e.g. ``T_b = k_b·P·(1 − 6.4e-04·ω)`` or
     ``F_x,read = F_x + 0.0123·F_z``."""
     if set(candidate.keys) & set(RUNOUT_KEYS):
-        waves = [f"{100 * params.number(k):.2f} %·cos({m}θ + φ{m})" for m, k in
-                 zip(ORDERS, RUNOUT_KEYS[::2], strict=True) if k in candidate.keys]
-        return f"ω_read = ω·(1 + {' + '.join(waves)}), θ: wheel angle, φ: each run's own"
+        return f"ω_read = ω·(1 + {_waves(candidate, params, RUNOUT_KEYS)}), θ: wheel angle, " \
+            "φ: each run's own"
+    if set(candidate.keys) & set(BRAKE_RUNOUT_KEYS):
+        gain = params.number("brake.gain_n_m_per_pa") * PA_PER_BAR
+        return (f"T_b = {gain:.4g} N m/bar·P·(1 + {_waves(candidate, params, BRAKE_RUNOUT_KEYS)}"
+                "), θ: wheel angle, φ: each run's own")
     if SKEW_KEY in candidate.keys:
         return f"ω_read(t) = ω(t − {1e3 * params.number(SKEW_KEY):.1f} ms)"
+    if PRESSURE_SKEW_KEY in candidate.keys:
+        return f"P_read(t) = P(t − {1e3 * params.number(PRESSURE_SKEW_KEY):.1f} ms)"
     if LOAD_KEY in candidate.keys:
         per_kn = 1e5 * params.number(LOAD_KEY)
         reference = reference_load_n(params)

@@ -48,6 +48,12 @@ class Finding:
     """A ``discovered`` finding: the library family of its terms (``sliding_speed``, ...)."""
     term: str = ""
     """A ``discovered`` finding: the extended law with its fitted values."""
+    equation: str = ""
+    """An ``unexplained`` finding: the equation (or the channel's measurement) whose error
+    carries it: ``valve``, ``wheel``, ``flywheel``, ``loading device``, ``pressure channel``,
+    ``wheel channel``, ..."""
+    channel: str = ""
+    """An ``unexplained`` finding: the measured channel its evidence was found in."""
 
     def to_json(self) -> dict[str, object]:
         document: dict[str, object] = {"cause": self.cause, "parameters": self.parameters,
@@ -57,6 +63,8 @@ class Finding:
                     "fitted_on": list(self.fitted_on), "checked_on": list(self.checked_on)}
         if self.family:
             document |= {"family": self.family, "term": self.term}
+        if self.equation:
+            document |= {"equation": self.equation, "channel": self.channel}
         return document
 
 

@@ -27,7 +27,6 @@ from landing_gear_sim.calibration.statistics import (
     linear_std,
     weighted_least_squares,
 )
-from landing_gear_sim.model import elements as el
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import PA_PER_BAR
 
@@ -73,19 +72,10 @@ class _Samples:
     variables: dict[str, np.ndarray]
 
 
-def _model_torque(params: RigParameters, pressure: np.ndarray, energy: np.ndarray,
-                  wheel: np.ndarray, campaign_order: float) -> np.ndarray:
-    """The model's brake torque for these samples [N m]: its whole gain law."""
-    p = params.vector()
-    torque = np.array([el.brake_torque(p, pa, e, w)
-                       for pa, e, w in zip(pressure, energy, wheel, strict=True)])
-    return torque * (1.0 + params.number("brake.gain_drift_per_run") * campaign_order)
-
-
 def _samples(b: br.Braking, params: RigParameters) -> _Samples:
     torque, energy = br.torque_balance(b, params)
     m = np.flatnonzero(br.steady_braking_samples(b))[::DECIMATE]
-    model = _model_torque(params, b.pressure[m], energy[m], b.wheel[m], b.run.campaign_order)
+    model = br.model_torque(b, params, energy, m)
     return _Samples(torque[m], model, {
         "wheel speed": b.wheel[m], "vertical load": b.load[m],
         "pressure": b.pressure[m] / PA_PER_BAR, "brake energy": energy[m] / 1e6,

@@ -108,11 +108,14 @@ def _names(runs: Sequence[Run]) -> tuple[str, ...]:
 
 def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParameters,
                     datasheet: RigParameters, scales: Scales,
-                    signatures: Sequence[Signature]) -> Scored:
-    """Fit ``candidate`` and its null on the fitting runs; compare both on held-out runs."""
+                    signatures: Sequence[Signature], start: RigParameters | None = None
+                    ) -> Scored:
+    """Fit ``candidate`` and its null on the fitting runs; compare both on held-out runs.
+    The candidate's fit starts from ``start`` when given (a model calibrated again with
+    it), its null's from ``model`` (the best the runs give without it)."""
     fit_runs, held_runs = split_runs(candidate, runs)
     sub = _as_fitting(candidate, fit_runs)
-    with_it = fit_candidate(sub, fit_runs, model, datasheet, scales=scales)
+    with_it = fit_candidate(sub, fit_runs, start or model, datasheet, scales=scales)
     without = fit_candidate(sub, fit_runs, model, datasheet, null=True, scales=scales)
     k = len(candidate.keys)
     n_eff = effective_count(without.residual)
@@ -130,15 +133,18 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
         after = channel_fits(held_runs, sim_with, channels)
     gain = float(np.mean([after[c] - before[c] for c in after])) if after else 0.0
     at_bound = _at_bound(candidate, with_it)
+    beyond = candidate.reach(with_it.values, fit_runs, with_it.params) if candidate.reach \
+        else ""
     accepted = (delta_bic < BIC_THRESHOLD and held_delta is not None
                 and held_delta < HELD_OUT_THRESHOLD and gain >= MIN_GAIN_POINTS
-                and not at_bound)
+                and not at_bound and not beyond)
     parameters = key_parameters(candidate, with_it.params)
     std = key_std(candidate, with_it)
     finding = Finding(candidate.cause, parameters, std,
                       _evidence(candidate, delta_bic, held_delta, before, after, fit_runs,
                                 held_runs, signatures)
-                      + ("; a key parameter sits at the edge of its range" if at_bound else ""),
+                      + ("; a key parameter sits at the edge of its range" if at_bound else "")
+                      + (f"; not accepted: {beyond}" if beyond else ""),
                       before, after, round(delta_bic, 1),
                       None if held_delta is None else round(held_delta, 1), accepted,
                       _names(fit_runs), _names(held_runs))

@@ -9,6 +9,7 @@ pressure direction in most runs. What the final model leaves is reported as an
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -16,6 +17,7 @@ import numpy as np
 
 from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
 from landing_gear_sim.diagnosis import residuals as rs
+from landing_gear_sim.diagnosis.equations import Place
 from landing_gear_sim.diagnosis.findings import Finding, Signature, SignatureKind
 from landing_gear_sim.model.elements import slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
@@ -24,7 +26,10 @@ from msg_tools.run import Run
 from msg_tools.units import PA_PER_BAR
 
 LINE_SIZE = 30.0  # a spectral line this far over the floor is structure, not noise
-LAG_SAMPLES = 1.0  # a consistent lag of a sample or more
+LAG_SAMPLES = 1.0  # a consistent lag of a sample or more ...
+LAG_Z = 4.0  # ... that many standard errors of the runs' median from zero
+MAD_TO_STD = 1.4826  # σ of normal values from their median absolute deviation
+MEDIAN_EFFICIENCY = 1.2533  # a median's standard error over a mean's (normal values)
 CORRELATION = 0.3  # |r| of the residual with a regressor ...
 CORRELATION_BANDS = 3.0  # ... and that many times its noise band
 # below 2 Hz a mis-calibrated model leaves a smooth trend, not a line
@@ -33,11 +38,16 @@ MIN_SPECTRUM_SAMPLES = 2048  # one Welch segment: a shorter window shows no line
 LAG_PRESSURE_SPAN_PA = 5 * PA_PER_BAR  # a run whose pressure moves this much shows a lag
 
 
-def _regressors(run: Run, params: RigParameters) -> dict[str, np.ndarray]:
+def _regressors(run: Run, model: Run, params: RigParameters) -> dict[str, np.ndarray]:
+    """What the wheel-speed residual may depend on. Nothing here is read from the measured
+    wheel channel (its noise would correlate with itself: slip read from a counting
+    encoder's wheel speed correlated with the residual at r = −0.77 on a null campaign):
+    where the wheel speed enters, the ``model``'s simulation of it does."""
     speed = rim_speed_m_s(params, run.flywheel_speed_rad_s)
-    slip = slip_ratio(speed, run.wheel_speed_rad_s, params.number("wheel.unloaded_radius_m"))
+    wheel = model.wheel_speed_rad_s
+    slip = slip_ratio(speed, wheel, params.number("wheel.unloaded_radius_m"))
     smooth_pressure = np.convolve(run.pressure_pa, np.ones(20) / 20, mode="same")
-    energy = np.cumsum(np.clip(run.pressure_pa, 0, None) * np.clip(run.wheel_speed_rad_s, 0, None))
+    energy = np.cumsum(np.clip(run.pressure_pa, 0, None) * np.clip(wheel, 0, None))
     return {"vertical load": run.vertical_load_n, "speed": speed,
             "slip": slip, "pressure": run.pressure_pa,
             "brake energy": energy, "pressure direction": np.sign(np.gradient(smooth_pressure))}
@@ -94,19 +104,26 @@ def find_signatures(runs: Sequence[ClassifiedRun], params: RigParameters,
             if channel == "wheel_speed_rad_s":
                 for c in rs.regressor_correlations(error[window],
                                                    {k: v[window] for k, v in
-                                                    _regressors(run, params).items()}):
+                                                    _regressors(run, model, params).items()}):
                     correlations.setdefault(c.name, []).append((run.name, c.value, c.band))
-        if np.ptp(run.pressure_pa) > LAG_PRESSURE_SPAN_PA:
-            lags.setdefault("pressure_pa", []).append(
-                (run.name, rs.lag_samples(run.pressure_pa, model.pressure_pa, 50) / run.rate_hz))
-        if run.braking and window.sum() >= MIN_SPECTRUM_SAMPLES:
-            # a logger channel out of step with the others (20 ms once gave 'none')
-            lags.setdefault("wheel_speed_rad_s", []).append(
-                (run.name, rs.lag_samples(run.wheel_speed_rad_s[window],
-                                          model.wheel_speed_rad_s[window], 50) / run.rate_hz))
+        for channel, timed in _timed_channels(run, window).items():
+            lags.setdefault(channel, []).append(
+                (run.name, rs.lag_samples(getattr(run, channel)[timed],
+                                          getattr(model, channel)[timed], 50) / run.rate_hz))
     return [*_recurring_lines(lines),
             *(s for channel, found in lags.items() for s in _consistent_lag(channel, found, runs)),
             *_consistent_correlations(correlations)]
+
+
+def _timed_channels(run: ClassifiedRun, window: np.ndarray) -> dict[str, np.ndarray]:
+    """The channels whose timing ``run`` shows, with the samples that show it: the pressure
+    where it moves (the whole run), the wheel in a stop's ``window``."""
+    timed = {"pressure_pa": np.ones(len(run), dtype=bool)} \
+        if np.ptp(run.pressure_pa) > LAG_PRESSURE_SPAN_PA else {}
+    if run.braking and window.sum() >= MIN_SPECTRUM_SAMPLES:
+        # a logger channel out of step with the others (20 ms once gave 'none')
+        timed["wheel_speed_rad_s"] = window
+    return timed
 
 
 def _recurring_lines(lines: dict[str, list[tuple[str, float, float]]]) -> list[Signature]:
@@ -129,13 +146,21 @@ def _recurring_lines(lines: dict[str, list[tuple[str, float, float]]]) -> list[S
 
 def _consistent_lag(channel: str, lags: list[tuple[str, float]], runs: Sequence[Run]
                     ) -> list[Signature]:
+    """A lag the runs agree on: a sample or more, of one sign in most runs, and LAG_Z
+    standard errors of the runs' median from zero. The error is robust (from the median
+    absolute deviation: a smoothly decelerating wheel reads any error in its speed as a
+    lag, −24 to +2 ms over the stops of one null campaign) and no smaller than the log's own
+    timing, a period/√12 per run."""
     if len(lags) < 2:
         return []
     values = np.array([v for _, v in lags])
     rate = float(np.median([r.rate_hz for r in runs]))
     median = float(np.median(values))
     same_sign = np.mean(np.sign(values) == np.sign(median))
-    if abs(median) * rate >= LAG_SAMPLES and same_sign >= 0.75:
+    spread = MAD_TO_STD * float(np.median(np.abs(values - median)))
+    error = MEDIAN_EFFICIENCY * max(spread, 1.0 / (rate * math.sqrt(12.0))) / math.sqrt(
+        values.size)
+    if abs(median) * rate >= LAG_SAMPLES and same_sign >= 0.75 and abs(median) >= LAG_Z * error:
         return [Signature(SignatureKind.LAG, channel, median, abs(median) * rate,
                           tuple(n for n, _ in lags))]
     return []
@@ -158,10 +183,30 @@ def _consistent_correlations(found: dict[str, list[tuple[str, float, float]]]
     return sorted(out, key=lambda s: -abs(s.value))
 
 
-def unexplained(signatures: Sequence[Signature], baseline: dict[str, float]) -> Finding:
-    """The strongest remaining signature as an ``unexplained`` finding."""
+def window_regressors(run: ClassifiedRun, model: Run, params: RigParameters
+                      ) -> dict[str, np.ndarray]:
+    """What a braking run's wheel-speed residual is correlated with, over its window."""
+    window = _window(run, params)
+    return {k: v[window] for k, v in _regressors(run, model, params).items()}
+
+
+def unexplained(signatures: Sequence[Signature], baseline: dict[str, float],
+                places: Sequence[Place | None] = ()) -> Finding:
+    """The strongest remaining signature as an ``unexplained`` finding, each with the
+    equation it lives in where ``places`` (:func:`~.equations.locate_all`) tell."""
     best = signatures[0]
+    where = list(places) + [None] * (len(signatures) - len(places))
+    words = [s.describe() + (f" — {place.describe()}" if place else "")
+             for s, place in zip(signatures[:3], where, strict=False)]
+    equation = where[0].equation.value if where[0] else _channel_equation(best.channel)
     return Finding("unexplained", {best.kind.parameter: round(best.value, 6)}, {},
-                   "no candidate of the catalogue explains: "
-                   + "; ".join(s.describe() for s in signatures[:3]),
-                   baseline, baseline, None, None, False, best.runs, ())
+                   "no candidate of the catalogue explains: " + "; ".join(words),
+                   baseline, baseline, None, None, False, best.runs, (),
+                   equation=equation, channel=best.channel)
+
+
+def _channel_equation(channel: str) -> str:
+    """Where a signature no equation's error carries lives: its channel's measurement (a
+    lag is the channel's own timing)."""
+    return {"pressure_pa": "pressure channel", "wheel_speed_rad_s": "wheel channel"}.get(
+        channel, channel)

@@ -16,7 +16,7 @@ import numpy as np
 from landing_gear_sim.model import actuator, plant, quantities
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.scenario import Scenario
-from landing_gear_sim.model.sensors import SensorModel
+from landing_gear_sim.model.sensors import SensorModel, late
 
 
 @dataclass(frozen=True)
@@ -69,6 +69,25 @@ class LoadingBlock:
         return float(plant.loading_step(self._p, self._state, t, speed, self._step_s))
 
 
+class History:
+    """A channel ``delay_s`` out of step (:func:`~landing_gear_sim.model.sensors.late`), read
+    one sample at a time from the recent samples it keeps (a value as it is when in step)."""
+
+    def __init__(self, delay_s: float, step_s: float) -> None:
+        self._delay_s = delay_s
+        kept = math.ceil(delay_s / step_s) + 2 if delay_s > 0.0 else 1
+        self._samples: deque[tuple[float, float]] = deque(maxlen=kept)
+
+    def read(self, time_s: float, value: float) -> float:
+        """The channel's reading at ``time_s``, where the true value is ``value``."""
+        if self._delay_s <= 0.0:
+            return value
+        if not self._samples or self._samples[-1][0] < time_s:
+            self._samples.append((time_s, value))
+        times, values = (np.array(column) for column in zip(*self._samples, strict=True))
+        return float(late(times, values, self._delay_s)[-1])
+
+
 class PlantBlock:
     """Wheel, tyre, gear walk, flywheel and sensors of one scenario, advanced step by step.
 
@@ -87,9 +106,9 @@ class PlantBlock:
         self._row = np.empty(plant.N_CHANNELS)
         self._params = params
         self._sensors = SensorModel.of(params)
-        # the wheel channel out of step reads this many recent samples (none when in step)
-        kept = math.ceil(self._sensors.wheel_delay_s / scenario.step_s) + 2
-        self._wheel_history: deque[tuple[float, float]] = deque(maxlen=max(kept, 1))
+        # a channel out of step reads its recent samples (none when in step)
+        self._wheel_history = History(self._sensors.wheel_delay_s, scenario.step_s)
+        self._pressure_history = History(self._sensors.pressure_delay_s, scenario.step_s)
         self._wheel_angle = (0.0, 0.0, 0.0)  # time [s], speed [rad/s], angle [rad] last read
         self.step_index = 0
         self.pressure_pa = 0.0
@@ -122,7 +141,8 @@ class PlantBlock:
         sensors, rng = self._sensors, self._noise
         return SensorSample(
             step=self.step_index, time_s=float(row[0]),
-            pressure_pa=float(sensors.pressure(row[2], rng)),
+            pressure_pa=float(sensors.pressure(self._pressure_history.read(row[0], row[2]),
+                                               rng)),
             wheel_speed_rad_s=float(sensors.speed(self._wheel_read(row[0], row[3]), rng)),
             flywheel_speed_rad_s=float(sensors.speed(
                 quantities.flywheel_speed_rad_s(self._params, row[4]), rng)),
@@ -133,12 +153,7 @@ class PlantBlock:
         """The wheel channel's noise-free reading now (out of step: from recent samples)."""
         if self._sensors.ripples:
             wheel_rad_s = self._encoder(time_s, wheel_rad_s)
-        if self._sensors.wheel_delay_s <= 0.0:
-            return wheel_rad_s
-        if not self._wheel_history or self._wheel_history[-1][0] < time_s:
-            self._wheel_history.append((time_s, wheel_rad_s))
-        times, wheel = (np.array(column) for column in zip(*self._wheel_history, strict=True))
-        return float(self._sensors.out_of_step(times, wheel)[-1])
+        return self._wheel_history.read(time_s, wheel_rad_s)
 
     def _encoder(self, time_s: float, wheel_rad_s: float) -> float:
         """The encoder's reading at the wheel's angle, advanced by the trapezoid from the

@@ -13,6 +13,8 @@ is skipped when its ``elements.<name>`` flag is 0. Equation numbers refer to the
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
@@ -33,6 +35,11 @@ HAS_FADE = INDEX["elements.brake_fade"]
 RELAXATION = INDEX["tyre.relaxation_length_m"]
 FADE_FRACTION = INDEX["brake.fade_fraction"]
 FADE_ENERGY = INDEX["brake.fade_energy_j"]
+FADE_SHAPE = INDEX["brake.fade_shape"]
+BRAKE_RUNOUT_1 = INDEX["brake.runout_1"]
+BRAKE_RUNOUT_1_PHASE = INDEX["brake.runout_1_phase_rad"]
+BRAKE_RUNOUT_2 = INDEX["brake.runout_2"]
+BRAKE_RUNOUT_2_PHASE = INDEX["brake.runout_2_phase_rad"]
 GAIN_SLOPE_SPEED = INDEX["brake.gain_slope_wheel_speed_s_per_rad"]
 GAIN_SLOPE_PRESSURE = INDEX["brake.gain_slope_pressure_per_pa"]
 FLY_RADIUS = INDEX["flywheel.radius_m"]
@@ -132,27 +139,47 @@ def slip_ratio(hub_speed_m_s, wheel_speed_rad_s, radius_m):
 
 
 @njit(cache=True, inline="always")
-def fade_factor(fade_fraction, brake_energy_j, fade_energy_j):
-    """Share of the brake gain left after absorbing ``brake_energy_j``:
-    1 − φ (1 − e^{−E/E_f}) (the ``brake_fade`` element)."""
-    return 1.0 - fade_fraction * (1.0 - np.exp(-brake_energy_j / fade_energy_j))
+def fade_factor(fade_fraction, brake_energy_j, fade_energy_j, shape):
+    """Share of the brake gain left after absorbing ``brake_energy_j`` (the ``brake_fade``
+    element): 1 − φ g(E/E_f), g(x) = 1 − (1 + s x)^(−1/s) — for s = 0 the exponential
+    1 − e^{−x} (its limit), for s = 1 the hyperbola x/(1 + x), the same first slope
+    g'(0) = 1 for every shape s (a fade's shape is the rig's: an independent rig's
+    hyperbolic fade of 15 % read as 11 % through the exponential alone)."""
+    x = brake_energy_j / fade_energy_j
+    if shape <= 0.0:
+        return 1.0 - fade_fraction * (1.0 - np.exp(-x))
+    return 1.0 - fade_fraction * (1.0 - np.exp(-np.log1p(shape * x) / shape))
 
 
 @njit(cache=True)
-def brake_torque(p, pressure_pa, brake_energy_j, wheel_speed_rad_s):
+def brake_torque(p, pressure_pa, brake_energy_j, wheel_speed_rad_s, wheel_angle_rad):
     """Brake torque T_b = k_b P_b, eq. (8); a brake cannot push, so P_b < 0 gives 0.
 
     With ``brake_fade`` the gain falls as the brake heats: k_b·:func:`fade_factor`. The
     gain's slopes in wheel speed and pressure (0 on the reference rig) scale it by
-    1 + s_ω ω + s_P P (never below 0): terms outside the paper that a rig may have.
+    1 + s_ω ω + s_P P (never below 0), and a disc's run-out by 1 + Σ e_m cos(mθ + φ_m),
+    m = 1, 2, θ the wheel's angle: terms outside the paper that a rig may have.
     """
     gain = p[BRAKE_GAIN]
     if p[HAS_FADE]:
-        gain *= fade_factor(p[FADE_FRACTION], brake_energy_j, p[FADE_ENERGY])
+        gain *= fade_factor(p[FADE_FRACTION], brake_energy_j, p[FADE_ENERGY], p[FADE_SHAPE])
     pressure = max(pressure_pa, 0.0)
     gain *= max(1.0 + p[GAIN_SLOPE_SPEED] * wheel_speed_rad_s
                 + p[GAIN_SLOPE_PRESSURE] * pressure, 0.0)
+    if p[BRAKE_RUNOUT_1] != 0.0 or p[BRAKE_RUNOUT_2] != 0.0:
+        gain *= 1.0 + p[BRAKE_RUNOUT_1] * math.cos(wheel_angle_rad + p[BRAKE_RUNOUT_1_PHASE]) \
+            + p[BRAKE_RUNOUT_2] * math.cos(2.0 * wheel_angle_rad + p[BRAKE_RUNOUT_2_PHASE])
     return gain * pressure
+
+
+@njit(cache=True)
+def brake_torques(p, pressure_pa, brake_energy_j, wheel_speed_rad_s, wheel_angle_rad):
+    """:func:`brake_torque` of each sample of four arrays of one shape (n,) [N m]."""
+    out = np.empty(pressure_pa.shape[0])
+    for i in range(out.shape[0]):
+        out[i] = brake_torque(p, pressure_pa[i], brake_energy_j[i], wheel_speed_rad_s[i],
+                              wheel_angle_rad[i])
+    return out
 
 
 @njit(cache=True)

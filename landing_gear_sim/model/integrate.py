@@ -20,6 +20,7 @@ from landing_gear_sim.model.plant import (
     N_CHANNELS,
     N_STATES,
     SPEED,
+    WHEEL_ANGLE,
     loading_step,
     plant_step,
     record,
@@ -33,8 +34,10 @@ STOP_REASONS = ("end of input", "stop speed reached")
 
 
 @njit(cache=True)
-def run_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed, out):
-    """Simulate one run; fill ``out`` (n, N_CHANNELS); return (rows written, stop code)."""
+def run_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed, angle, out):
+    """Simulate one run; fill ``out`` (n, N_CHANNELS); return (rows written, stop code).
+    ``angle``: the wheel's measured angle at each step (n,), which the plant's angle takes
+    at every exchange, or empty: the plant's own."""
     x = np.zeros(N_STATES)
     x[SPEED] = initial_speed if contact else 0.0
     xa = actuator_state(matrices)
@@ -45,8 +48,11 @@ def run_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed,
     # exactly 0): stepping it only costs time (~80 % of an actuator run's simulation)
     at_rest = not contact and initial_speed == 0.0
     n = current.shape[0]
+    follow = angle.shape[0] > 0
     for k in range(n):
         t = k * step_s
+        if follow:
+            x[WHEEL_ANGLE] = angle[k]
         record(p, x, t, current[k], pressure, load, out[k])
         if contact and stop_speed > 0.0 and x[SPEED] < stop_speed:
             return k + 1, 1
@@ -75,7 +81,7 @@ def batch_kernel(p, matrices, current, step_s, contact, initial_speed, stop_spee
     """``run_kernel`` over parameter sets ``p`` (m, N_PARAMS) in parallel; inputs (m, n)."""
     for i in prange(p.shape[0]):
         rows[i], stop[i] = run_kernel(p[i], matrices[i], current[i], step_s, contact,
-                                      initial_speed, stop_speed, out[i])
+                                      initial_speed, stop_speed, np.zeros(0), out[i])
 
 
 @dataclass(frozen=True)
@@ -107,7 +113,8 @@ class SimulationResult:
         pressure = np.empty(self.scenario.current_a.size)
         actuator_kernel(vector, actuator_matrices(vector, self.scenario.step_s),
                         self.scenario.current_a, pressure)
-        return SensorModel.of(self.params).pressure(pressure)
+        times = np.arange(pressure.size) * self.scenario.step_s
+        return SensorModel.of(self.params).pressure_channel(times, pressure)
 
     def to_run(self, noise: np.random.Generator | int | None = None,
                wheel_angle_rad: np.ndarray | None = None) -> Run:
@@ -124,7 +131,7 @@ class SimulationResult:
         return Run(
             name=self.scenario.name, source="simulation", time_s=self.time_s.copy(),
             current_a=held_to_logged(self.current_a),
-            pressure_pa=sensors.pressure(self.pressure_pa, rng),
+            pressure_pa=sensors.pressure_channel(self.time_s, self.pressure_pa, rng),
             wheel_speed_rad_s=sensors.wheel_speed(self.time_s, self.wheel_speed_rad_s, rng,
                                                   wheel_angle_rad),
             flywheel_speed_rad_s=sensors.speed(flywheel_speed_rad_s(self.params, self.speed_m_s),
@@ -142,9 +149,10 @@ def simulate(params: RigParameters, scenario: Scenario) -> SimulationResult:
     """Simulate one scenario with one parameter set."""
     vector = params.vector()
     out = np.empty((scenario.current_a.size, N_CHANNELS))
+    angle = np.zeros(0) if scenario.wheel_angle_rad is None else scenario.wheel_angle_rad
     rows, stop = run_kernel(vector, actuator_matrices(vector, scenario.step_s),
                             scenario.current_a, scenario.step_s, scenario.contact,
-                            scenario.initial_speed_m_s, scenario.stop_speed_m_s, out)
+                            scenario.initial_speed_m_s, scenario.stop_speed_m_s, angle, out)
     return SimulationResult(scenario, params, out[:rows].copy(), STOP_REASONS[stop])
 
 

@@ -154,6 +154,22 @@ SPECS: tuple[ParamSpec, ...] = (
                   "phase phi of that ripple at the run's first sample (theta = 0 there; a "
                   "measured run's own is read from its wheel channel)", signed=True,
                   default=0.0))),
+    ParamSpec("brake.fade_shape", "-",
+              "shape s of the fade (brake_fade): k_b (1 - fraction g(E/energy)), g(x) = 1 - (1 + "
+              "s x)^(-1/s); 0: the exponential 1 - exp(-x), 1: the hyperbola x/(1 + x); the "
+              "same first slope for every s", default=0.0),
+    ParamSpec("sensors.pressure_delay_s", "s",
+              "the pressure channel reads the pressure this much earlier than the others are "
+              "read (a logger channel out of step; 0: none)", default=0.0),
+    *(spec for order in (1, 2) for spec in (
+        ParamSpec(f"brake.runout_{order}", "-",
+                  f"the brake torque is k_b P (1 + e cos({order} theta + phi)): a ripple "
+                  f"{order}x per wheel revolution, relative (disc run-out, thickness "
+                  "variation; 0: none)", default=0.0),
+        ParamSpec(f"brake.runout_{order}_phase_rad", "rad",
+                  "phase phi of that ripple at the run's first sample (theta = 0 there; a "
+                  "measured run's own is read from its torque balance)", signed=True,
+                  default=0.0))),
 )
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}

@@ -18,8 +18,10 @@ locked while the brake torque exceeds the tyre torque.
 
 Plant state vector (``N_STATES``): speed v (flywheel rim or aircraft) [m/s],
 gear-walk angle θ [rad] and rate [rad/s], wheel speed ω [rad/s], and four energy
-accumulators [J] (brake, drag, tyre slip, gear-walk damping) for bookkeeping, and the
-relaxed tyre force [N] (used by the ``tire_relaxation`` element only).
+accumulators [J] (brake, drag, tyre slip, gear-walk damping) for bookkeeping, the
+relaxed tyre force [N] (used by the ``tire_relaxation`` element only) and the wheel's angle
+since the run's start [rad] (a disc's run-out acts at it; a simulation of a measured run
+sets it to the measured angle at each exchange step).
 """
 
 from __future__ import annotations
@@ -30,8 +32,9 @@ from numba import njit
 
 from landing_gear_sim.model import elements as el
 
-SPEED, ANGLE, ANGLE_RATE, OMEGA, E_BRAKE, E_DRAG, E_SLIP, E_DAMP, TYRE_FORCE = range(9)
-N_STATES = 9
+(SPEED, ANGLE, ANGLE_RATE, OMEGA, E_BRAKE, E_DRAG, E_SLIP, E_DAMP, TYRE_FORCE,
+ WHEEL_ANGLE) = range(10)
+N_STATES = 10
 
 MAX_SUBSTEP_S = 1e-3  # physics runs at 1 kHz or finer whatever the exchange rate
 STABILITY_MARGIN = 1.0  # h·|λ_max| per substep; RK4's real-axis limit is 2.78
@@ -67,7 +70,7 @@ def tyre_state(p, x, vertical_load_n):
 def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     """Write dx/dt of the plant state into ``dx`` (eqs. 1-8; rig or aircraft form)."""
     radius, hub, slip, fx = tyre_state(p, x, vertical_load_n)
-    tb = el.brake_torque(p, pressure_pa, x[E_BRAKE], x[OMEGA])
+    tb = el.brake_torque(p, pressure_pa, x[E_BRAKE], x[OMEGA], x[WHEEL_ANGLE])
     drag = el.drag_force(p, x[SPEED])
     mass = el.translational_mass(p)
     if p[el.HAS_GEAR_WALK] == 0.0:
@@ -92,6 +95,7 @@ def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     dx[E_DAMP] = p[el.GW_DAMPING] * x[ANGLE_RATE] ** 2 if p[el.HAS_GEAR_WALK] else 0.0
     steady = vertical_load_n * el.tyre_friction(p, slip, x[SPEED], vertical_load_n)
     dx[TYRE_FORCE] = el.relaxation_rate(p, hub) * (steady - x[TYRE_FORCE])
+    dx[WHEEL_ANGLE] = x[OMEGA]
 
 
 @njit(cache=True)
@@ -158,7 +162,7 @@ def loading_step(p, xl, time_s, speed_m_s, step_s):
 def record(p, x, time_s, current_a, pressure_pa, load_n, row):
     """Fill one output row (see CHANNELS) from the state at ``time_s``."""
     radius, hub, slip, fx = tyre_state(p, x, load_n)
-    tb = el.brake_torque(p, pressure_pa, x[E_BRAKE], x[OMEGA])
+    tb = el.brake_torque(p, pressure_pa, x[E_BRAKE], x[OMEGA], x[WHEEL_ANGLE])
     omega_dot = el.wheel_acceleration(p, x[OMEGA], radius, fx, tb)
     row[0], row[1], row[2] = time_s, current_a, pressure_pa
     row[3], row[4], row[5] = x[OMEGA], x[SPEED], hub

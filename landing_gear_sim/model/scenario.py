@@ -39,6 +39,9 @@ class Scenario:
         initial_speed_m_s: flywheel rim (or aircraft) speed at t = 0.
         stop_speed_m_s: the run ends when the speed falls below this; 0 runs to
             the end of the input.
+        wheel_angle_rad: the wheel's angle at each sample, shape (n,), when the run
+            follows a measured one (a disc's run-out acts at the measured angle); None:
+            the plant's own.
     """
 
     name: str
@@ -48,6 +51,7 @@ class Scenario:
     initial_speed_m_s: float
     stop_speed_m_s: float
     description: str = field(default="")
+    wheel_angle_rad: np.ndarray | None = field(default=None, kw_only=True)
 
     def __post_init__(self) -> None:
         current = np.asarray(self.current_a, dtype=float)
@@ -58,6 +62,12 @@ class Scenario:
         if not (math.isfinite(self.rate_hz) and self.rate_hz > 0):
             raise ScenarioError(f"{self.name}: rate must be > 0 Hz, got {self.rate_hz}")
         object.__setattr__(self, "current_a", current)
+        if self.wheel_angle_rad is not None:
+            angle = np.ascontiguousarray(self.wheel_angle_rad, dtype=float)
+            if angle.shape != current.shape:
+                raise ScenarioError(f"{self.name}: the wheel angle has shape {angle.shape}, "
+                                    f"the current {current.shape}")
+            object.__setattr__(self, "wheel_angle_rad", angle)
 
     @property
     def step_s(self) -> float:

@@ -3,9 +3,10 @@
 Pressure transducer: the true gauge pressure plus ``sensors.pressure_offset_pa`` when the
 ``pressure_sensor_offset`` element is on, plus white noise. Encoders and the load cell:
 the true value plus white noise; the load cell's longitudinal channel also reads
-``sensors.crosstalk_fx_per_fz`` of the vertical load (0 on a clean channel), and the wheel
-encoder's channel may be ``sensors.wheel_speed_delay_s`` out of step with the others (it
-reads the wheel speed that much earlier, linearly interpolated; 0: in step) and may ripple
+``sensors.crosstalk_fx_per_fz`` of the vertical load (0 on a clean channel), the pressure
+channel may be ``sensors.pressure_delay_s`` and the wheel encoder's
+``sensors.wheel_speed_delay_s`` out of step with the others (each reads its quantity that
+much earlier, linearly interpolated; 0: in step), and the encoder's channel may ripple
 once and twice per wheel revolution (``sensors.wheel_runout_*``: ω (1 + e cos(mθ + φ)), θ the
 wheel angle since the run's first sample, the trapezoid integral of the sampled ω). Noise is
 drawn only when a random generator is given (``sensors.*_noise_*`` std; 0 means none), so a
@@ -35,6 +36,7 @@ class SensorModel:
     fx_per_fz: float = 0.0
     wheel_delay_s: float = 0.0
     runout: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0)  # e₁, φ₁ [rad], e₂, φ₂ [rad]
+    pressure_delay_s: float = 0.0
 
     @classmethod
     def of(cls, params: RigParameters) -> SensorModel:
@@ -45,7 +47,8 @@ class SensorModel:
                    params.number("sensors.force_noise_n"),
                    params.number("sensors.crosstalk_fx_per_fz"),
                    params.number("sensors.wheel_speed_delay_s"),
-                   tuple(params.number(k) for k in RUNOUT_KEYS))
+                   tuple(params.number(k) for k in RUNOUT_KEYS),
+                   params.number("sensors.pressure_delay_s"))
 
     @property
     def ripples(self) -> bool:
@@ -53,8 +56,15 @@ class SensorModel:
         return self.runout[0] != 0.0 or self.runout[2] != 0.0
 
     def pressure(self, true_pa: Value, rng: np.random.Generator | None = None) -> Value:
-        """Transducer reading [Pa, gauge] of the true brake pressure."""
+        """Transducer reading [Pa, gauge] of the true brake pressure (in step: see
+        :meth:`pressure_channel`)."""
         return _noisy(true_pa + self.pressure_offset_pa, self.pressure_noise_pa, rng)
+
+    def pressure_channel(self, times_s: np.ndarray, true_pa: np.ndarray,
+                         rng: np.random.Generator | None = None) -> np.ndarray:
+        """The pressure channel [Pa] of the samples at ``times_s``: the transducer's reading,
+        ``pressure_delay_s`` out of step (see :func:`late`)."""
+        return self.pressure(late(times_s, true_pa, self.pressure_delay_s), rng)
 
     def speed(self, true_rad_s: Value, rng: np.random.Generator | None = None) -> Value:
         """Encoder reading [rad/s]."""
@@ -86,9 +96,7 @@ class SensorModel:
         """The wheel speed ``wheel_delay_s`` before each of ``times_s`` (the first sample's
         before the start), noise-free. Element k needs only the samples from
         ``times_s[k] − wheel_delay_s`` on: the plant node passes its recent history."""
-        if self.wheel_delay_s <= 0.0:
-            return true_rad_s
-        return np.interp(times_s - self.wheel_delay_s, times_s, true_rad_s)
+        return late(times_s, true_rad_s, self.wheel_delay_s)
 
     def longitudinal(self, true_fx_n: Value, true_fz_n: Value,
                      rng: np.random.Generator | None = None) -> Value:
@@ -106,6 +114,16 @@ class SensorModel:
 
 RUNOUT_KEYS = ("sensors.wheel_runout_1", "sensors.wheel_runout_1_phase_rad",
                "sensors.wheel_runout_2", "sensors.wheel_runout_2_phase_rad")
+
+
+def late(times_s: np.ndarray, values: np.ndarray, delay_s: float) -> np.ndarray:
+    """``values`` (at the increasing ``times_s``) as a channel ``delay_s`` late reads them:
+    each sample's value ``delay_s`` before it, linearly interpolated (the first sample's
+    before the start); ``values`` itself when in step. Element k needs only the samples from
+    ``times_s[k] − delay_s`` on: a block passes its recent history."""
+    if delay_s <= 0.0:
+        return values
+    return np.interp(times_s - delay_s, times_s, values)
 
 
 def wheel_angle_rad(times_s: np.ndarray, speed_rad_s: np.ndarray) -> np.ndarray:

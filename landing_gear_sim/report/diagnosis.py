@@ -89,7 +89,8 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
     findings = html_table(
         ["cause", "parameters (SI) ± 1σ", "ΔBIC", "held-out Δ", "held-out fit before",
          "after", "evidence"],
-        [[f.cause + (f" ({f.family}): {f.term}" if f.term else ""),
+        [[f.cause + (f" ({f.family}): {f.term}" if f.term else "")
+          + (f" — in the {f.equation} ({f.channel})" if f.equation else ""),
           ", ".join(f"{k} = {v:.5g}" + (f" ± {f.std[k]:.2g}" if k in f.std else "")
                     for k, v in f.parameters.items()),
           _text(f.delta_bic), _text(f.held_out), fits(f.fit_before), fits(f.fit_after),
@@ -212,6 +213,8 @@ def diagnosis_summary(result: Diagnosis) -> str:
         values = ", ".join(f"{k} = {v:.6g}" + (f" ± {f.std[k]:.2g}" if k in f.std else "")
                            for k, v in f.parameters.items())
         lines.append(f"  {f.cause}: {values}")
+        if f.equation:
+            lines.append(f"    where: the {f.equation} (seen in {f.channel})")
         if f.term:
             lines.append(f"    {f.family}: {f.term}")
         if f.fit_after and f.fit_after != f.fit_before:

@@ -47,6 +47,7 @@ from landing_gear_sim.calibration.logger import Logger
 from landing_gear_sim.campaigns.engine import Task, client, run_tasks
 from landing_gear_sim.diagnosis.catalogue import gear_walk_key_parameters
 from landing_gear_sim.diagnosis.diagnose import diagnose
+from landing_gear_sim.diagnosis.families import HIDDEN, Hidden
 from landing_gear_sim.diagnosis.scoring import HELD_OUT_THRESHOLD
 from landing_gear_sim.model.parameters import RigParameters, load_parameters
 from msg_tools.io import read_campaign, read_runs
@@ -110,56 +111,15 @@ CASES: dict[str, Case] = {
 }
 
 
-def _runout(rng: np.random.Generator, datasheet: RigParameters) -> dict:
-    """An encoder ripple once or twice per revolution (the generator gives each run a start
-    angle of its own)."""
-    key = f"sensors.wheel_runout_{rng.choice([1, 2])}"
-    return {key: rng.uniform(0.002, 0.02), f"{key}_phase_rad": rng.uniform(-np.pi, np.pi)}
+def _hidden_case(hidden: Hidden) -> Case:
+    return Case(hidden.draw, hidden.key_of, lambda rig: rig.number(hidden.slot_of(rig)),
+                hidden.tolerance, hidden.absolute, light=hidden.light, family=hidden.family)
 
 
-def _runout_order(rig: RigParameters) -> str:
-    return "wheel_runout_1" if rig.number("sensors.wheel_runout_1") else "wheel_runout_2"
-
-
-# effects outside the catalogue (issue 14): the generator's own laws, off by default; the
-# diagnosis must answer 'discovered' with this family, a held-out gain and the parameter
-FAMILIES: dict[str, Case] = {
-    "sliding_speed": Case(
-        lambda r, d: {"brake.gain_slope_wheel_speed_s_per_rad":
-                      r.choice([-1, 1]) * r.uniform(0.08, 0.25) / 190.0},
-        "gain_slope_wheel_speed_s_per_rad", _number("brake.gain_slope_wheel_speed_s_per_rad"),
-        0.2),
-    "pressure_level": Case(
-        lambda r, d: {"brake.gain_slope_pressure_per_pa":
-                      r.choice([-1, 1]) * r.uniform(0.08, 0.25) / 50e5},
-        "gain_slope_pressure_per_pa", _number("brake.gain_slope_pressure_per_pa"), 0.2),
-    "channel_crosstalk": Case(
-        lambda r, d: {"sensors.crosstalk_fx_per_fz": r.choice([-1, 1]) * r.uniform(0.008, 0.03)},
-        "crosstalk_fx_per_fz", _number("sensors.crosstalk_fx_per_fz"), 0.1),
-    "channel_skew": Case(
-        lambda r, d: {"sensors.wheel_speed_delay_s": r.uniform(0.005, 0.03)},
-        "wheel_speed_delay_s", _number("sensors.wheel_speed_delay_s"), 1e-3, absolute=True),
-    "run_drift": Case(
-        lambda r, d: {"brake.gain_drift_per_run": r.choice([-1, 1]) * r.uniform(0.015, 0.04)},
-        "gain_drift_per_run", _number("brake.gain_drift_per_run"), 0.2),
-    "wheel_angle": Case(_runout, _runout_order,
-                        lambda rig: rig.number(f"sensors.{_runout_order(rig)}"), 0.1),
-    "load": Case(
-        lambda r, d: {"friction.load_sensitivity_per_n":
-                      r.choice([-1, 1]) * r.uniform(0.06, 0.15) / 1e4},  # 6-15 % per 10 kN
-        "load_sensitivity_per_n", _number("friction.load_sensitivity_per_n"), 0.2, light=True),
-    "input_history": Case(
-        lambda r, d: {"actuator.backlash_a": r.uniform(0.004, 0.04)},
-        "backlash_a", _number("actuator.backlash_a"), 0.2),
-    "disc_runout": Case(
-        lambda r, d: {"brake.runout_1": r.uniform(0.02, 0.08),
-                      "brake.runout_1_phase_rad": r.uniform(-np.pi, np.pi)},
-        "brake_runout_1", _number("brake.runout_1"), 0.1, family="wheel_angle"),
-    "pressure_late": Case(
-        lambda r, d: {"sensors.pressure_delay_s": r.uniform(0.004, 0.015)},
-        "pressure_delay_s", _number("sensors.pressure_delay_s"), 1e-3, absolute=True,
-        family="channel_skew"),
-}
+# effects outside the catalogue: every family's hidden effects, from the registry (the
+# generator's own laws, which the catalogue lacks); the diagnosis must answer 'discovered'
+# with that family, a held-out gain and the parameter
+FAMILIES: dict[str, Case] = {name: _hidden_case(hidden) for name, (_, hidden) in HIDDEN.items()}
 
 
 def random_logger(rng: np.random.Generator) -> Logger:
@@ -228,8 +188,8 @@ def case_task(cause: str | None, seed: int, light: bool = False, realities: bool
     ok, verdict, error = run_case(cause, seed, load_parameters(), light, realities)
     truth = cause or "none"
     if truth in FAMILIES:
-        truth = f"discovered {FAMILIES[truth].family or truth}" + (
-            f" ({truth})" if FAMILIES[truth].family else "")
+        family = FAMILIES[truth].family
+        truth = f"discovered {family}" + (f" ({truth})" if family != truth else "")
     return {"cause": truth, "seed": str(seed),
             "ok": ok, "verdict": verdict, "error": None if math.isnan(error) else error,
             "logger": ", ".join(random_logger(np.random.default_rng([seed, 2])).realities)
@@ -251,27 +211,29 @@ def independent_task(folder: str) -> dict:
 
 def _line(row: dict) -> str:
     error = math.nan if row["error"] is None else row["error"]
-    return (f"{row['cause']:30s} {row['seed']:>24s} {row['verdict']:30s} {error:10.3g} "
+    return (f"{row['cause']:40s} {row['seed']:>24s} {row['verdict']:30s} {error:10.3g} "
             f"{'yes' if row['ok'] else 'NO':>4s} {row['seconds']:6.1f}"
             + (f"  [{row['logger']}]" if row.get("logger") else ""))
 
 
 def confusion(rows: list[dict]) -> str:
-    """Truth × verdict counts, as text."""
+    """Truth × verdict counts, as text: one column per verdict, numbered (its legend
+    below), so the table stays as narrow as the counts."""
     truths = sorted({r["cause"] for r in rows})
     verdicts = sorted({r["verdict"] for r in rows})
-    width = max(len(v) for v in verdicts) + 1
-    lines = [" " * 30 + "".join(f"{v:>{width}s}" for v in verdicts)]
+    width = max(3, *(len(str(r["cause"])) for r in rows)) + 1
+    lines = [" " * width + "".join(f"{f'v{i}':>5s}" for i, _ in enumerate(verdicts, 1))]
     for truth in truths:
         counts = [sum(r["cause"] == truth and r["verdict"] == v for r in rows)
                   for v in verdicts]
-        lines.append(f"{truth:30s}" + "".join(f"{c or '.':>{width}}" for c in counts))
+        lines.append(f"{truth:{width}s}" + "".join(f"{c or '.':>5}" for c in counts))
+    lines.extend(f"  v{i}: {verdict}" for i, verdict in enumerate(verdicts, 1))
     return "\n".join(lines)
 
 
 def report(title: str, rows: list[dict]) -> None:
     print(f"\n== {title}")
-    header = f"{'truth':30s} {'campaign':>24s} {'verdict':30s} {'key error':>10s} {'ok':>4s}"
+    header = f"{'truth':40s} {'campaign':>24s} {'verdict':30s} {'key error':>10s} {'ok':>4s}"
     print(f"{header} {'s':>6s}")
     outcomes: dict[str, list[bool]] = {}
     for row in rows:
@@ -280,9 +242,9 @@ def report(title: str, rows: list[dict]) -> None:
     print("\nright per truth (target >= 95 %; none: 0 false alarms)")
     for name, results_ in outcomes.items():
         rate = sum(results_) / len(results_)
-        print(f"  {name:30s} {100 * rate:5.1f} %  ({sum(results_)}/{len(results_)})")
+        print(f"  {name:40s} {100 * rate:5.1f} %  ({sum(results_)}/{len(results_)})")
     total = sum(r["ok"] for r in rows)
-    print(f"  {'all':30s} {100 * total / max(len(rows), 1):5.1f} %  ({total}/{len(rows)})")
+    print(f"  {'all':40s} {100 * total / max(len(rows), 1):5.1f} %  ({total}/{len(rows)})")
     print("\nconfusion (rows: truth, columns: verdict)")
     print(confusion(rows))
 

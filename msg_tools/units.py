@@ -46,3 +46,18 @@ def parse_unit(text: str, quantity: str) -> str | None:
     if name in units:
         return name
     return {unit.lower(): unit for unit in units}.get(name.lower())
+
+
+DISPLAY: dict[str, tuple[str, float]] = {
+    "s": ("ms", 1e3), "A": ("mA", 1e3), "Pa": ("bar", 1.0 / PA_PER_BAR),
+    "N m/Pa": ("N m/bar", PA_PER_BAR), "1/N": ("%/kN", 1e5), "1": ("%", 100.0),
+    "N": ("kN", 1e-3),
+}
+"""SI unit -> the unit a brake engineer reads a term's value in, and the factor to it."""
+
+
+def display(value_si: float, unit: str, spec: str = ".4g") -> str:
+    """``value_si`` [``unit``] as a brake engineer reads it, e.g. 0.0047 s -> '4.7 ms'
+    (``spec``: the number's format); a unit without a display one is kept."""
+    shown, factor = DISPLAY.get(unit, (unit, 1.0))
+    return f"{value_si * factor:{spec}} {shown}"

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import OptimizeResult, least_squares
@@ -44,7 +44,7 @@ MAX_ITERATIONS = 40  # the budget of one optimisation (each step simulates the r
 FTOL = 1e-5
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Candidate:
     """A model extension the diagnosis can propose.
 
@@ -67,6 +67,8 @@ class Candidate:
         reach: why a fit's values lie beyond what the runs exercise ('' when they do not),
             from the fitted values, the runs fitted on and the fitted model; None: always
             within reach.
+        family: a discovered term's family (``diagnosis.families``); '' for a catalogue
+            cause.
     """
 
     cause: str
@@ -79,7 +81,8 @@ class Candidate:
     channels: tuple[str, ...]
     held_out: tuple[Selector, ...]
     contract: tuple[tuple[str, str], ...]
-    reach: Reach | None = field(default=None, kw_only=True)
+    reach: Reach | None = None
+    family: str = ""
 
 
 Reach = Callable[[dict[str, float], Sequence[ClassifiedRun], RigParameters], str]
@@ -116,53 +119,61 @@ BRAKE_RUNS: tuple[Selector, ...] = (Family.BRAKE,)
 CATALOGUE: dict[str, Candidate] = {c.cause: c for c in (
     # an actuator effect shows in every run's pressure: fitted on the actuator runs,
     # checked on the braking runs' pressure
-    Candidate("actuator_delay", "actuator_delay", ("actuator.delay_s",),
-              ((0.002,), (0.006,), (0.012,), (0.025,)), ((0.0, 0.06),), ACTUATOR,
-              ACTUATOR_RUNS, PRESSURE, BRAKE_RUNS, (("delay_s", "actuator.delay_s"),)),
+    Candidate(cause="actuator_delay", element="actuator_delay", keys=("actuator.delay_s",),
+              starts=((0.002,), (0.006,), (0.012,), (0.025,)), bounds=((0.0, 0.06),),
+              free=ACTUATOR, runs=ACTUATOR_RUNS, channels=PRESSURE, held_out=BRAKE_RUNS,
+              contract=(("delay_s", "actuator.delay_s"),)),
     # an offset shifts the whole map while calibrating it: re-fit the map with it; the
     # stretches below the dead-band tell the two apart
-    Candidate("pressure_sensor_offset", "pressure_sensor_offset",
-              ("sensors.pressure_offset_pa",), ((0.0,),),
-              ((-10 * PA_PER_BAR, 10 * PA_PER_BAR),), STATIC_MAP, ACTUATOR_RUNS, PRESSURE,
-              BRAKE_RUNS,
-              (("offset_pa", "sensors.pressure_offset_pa"),)),
-    Candidate("actuator_dynamics", "actuator_dynamics", ACTUATOR,
-              ((8.0, 0.5), (15.0, 0.8)), ((1.0, 60.0), (0.1, 2.0)), (), ACTUATOR_RUNS,
-              PRESSURE, BRAKE_RUNS, (("natural_frequency_hz", ACTUATOR[0]),
-                                     ("damping_ratio", ACTUATOR[1]))),
+    Candidate(cause="pressure_sensor_offset", element="pressure_sensor_offset",
+              keys=("sensors.pressure_offset_pa",), starts=((0.0,),),
+              bounds=((-10 * PA_PER_BAR, 10 * PA_PER_BAR),), free=STATIC_MAP,
+              runs=ACTUATOR_RUNS, channels=PRESSURE, held_out=BRAKE_RUNS,
+              contract=(("offset_pa", "sensors.pressure_offset_pa"),)),
+    Candidate(cause="actuator_dynamics", element="actuator_dynamics", keys=ACTUATOR,
+              starts=((8.0, 0.5), (15.0, 0.8)), bounds=((1.0, 60.0), (0.1, 2.0)), free=(),
+              runs=ACTUATOR_RUNS, channels=PRESSURE, held_out=BRAKE_RUNS,
+              contract=(("natural_frequency_hz", ACTUATOR[0]),
+                        ("damping_ratio", ACTUATOR[1]))),
     # fitted on the constant-pressure stops: in the oscillating runs the wheel nears the
     # skid and the output error jumps with the exact moment (a fit there got stuck at
     # 2/3 of the true length, in a valley of width ~1 %)
-    Candidate("tire_relaxation", "tire_relaxation", ("tyre.relaxation_length_m",),
-              ((0.1,), (0.4,), (1.0,)), ((0.005, 5.0),), FRICTION, (RunKind.BRAKE_CONSTANT,),
-              WHEEL, (),
-              (("relaxation_length_m", "tyre.relaxation_length_m"),)),
-    Candidate("gear_walk", "gear_walk", GEAR_WALK,
-              ((6.9e5, 1372.0), (3e5, 1000.0), (1.5e6, 2000.0)),
-              ((5e4, 2e7), (10.0, 5e4)), FRICTION, BRAKE_RUNS, WHEEL, (), ()),
-    Candidate("brake_fade", "brake_fade", FADE, ((0.1, 2e6), (0.3, 5e5)),
+    Candidate(cause="tire_relaxation", element="tire_relaxation",
+              keys=("tyre.relaxation_length_m",), starts=((0.1,), (0.4,), (1.0,)),
+              bounds=((0.005, 5.0),), free=FRICTION, runs=(RunKind.BRAKE_CONSTANT,),
+              channels=WHEEL, held_out=(),
+              contract=(("relaxation_length_m", "tyre.relaxation_length_m"),)),
+    Candidate(cause="gear_walk", element="gear_walk", keys=GEAR_WALK,
+              starts=((6.9e5, 1372.0), (3e5, 1000.0), (1.5e6, 2000.0)),
+              bounds=((5e4, 2e7), (10.0, 5e4)), free=FRICTION, runs=BRAKE_RUNS,
+              channels=WHEEL, held_out=(), contract=()),
+    Candidate(cause="brake_fade", element="brake_fade", keys=FADE,
+              starts=((0.1, 2e6), (0.3, 5e5)), bounds=((0.0, 0.9), (1e4, 1e8)),
               # the calibration bent the friction curve to absorb the fade: free it too
-              ((0.0, 0.9), (1e4, 1e8)), ("brake.gain_n_m_per_pa", *FRICTION), BRAKE_RUNS,
+              free=("brake.gain_n_m_per_pa", *FRICTION), runs=BRAKE_RUNS,
               # the measured force is the brake torque over r whatever the friction
               # curve (which the calibration distorted to absorb the fade)
-              ("longitudinal_force_n", "flywheel_speed_rad_s"), (),
-              (("fade_fraction", FADE[0]), ("fade_energy_j", FADE[1]),
-               ("gain_n_m_per_pa", "brake.gain_n_m_per_pa"),
-               ("fade_shape", "brake.fade_shape")), reach=fade_reach),
-    Candidate("drag", "drag", ("drag.coeff_n_s2_per_m2",), ((0.2,),), ((0.0, 5.0),),
-              ("flywheel.inertia_kg_m2",), BRAKE_RUNS, ("flywheel_speed_rad_s",), (),
-              (("drag_coeff_n_s2_per_m2", "drag.coeff_n_s2_per_m2"),)),
-    Candidate("load_dependent_radius", "load_dependent_radius",
-              ("radius.a_m_per_n2", "radius.b_m_per_n"), ((4e-12, 5e-7),),
+              channels=("longitudinal_force_n", "flywheel_speed_rad_s"), held_out=(),
+              contract=(("fade_fraction", FADE[0]), ("fade_energy_j", FADE[1]),
+                        ("gain_n_m_per_pa", "brake.gain_n_m_per_pa"),
+                        ("fade_shape", "brake.fade_shape")), reach=fade_reach),
+    Candidate(cause="drag", element="drag", keys=("drag.coeff_n_s2_per_m2",),
+              starts=((0.2,),), bounds=((0.0, 5.0),), free=("flywheel.inertia_kg_m2",),
+              runs=BRAKE_RUNS, channels=("flywheel_speed_rad_s",), held_out=(),
+              contract=(("drag_coeff_n_s2_per_m2", "drag.coeff_n_s2_per_m2"),)),
+    Candidate(cause="load_dependent_radius", element="load_dependent_radius",
+              keys=("radius.a_m_per_n2", "radius.b_m_per_n"), starts=((4e-12, 5e-7),),
+              bounds=((0.0, 1e-10), (0.0, 5e-6)),
               # without the element the calibration bent the friction curve (slip read
               # with one radius at every load): free it too
-              ((0.0, 1e-10), (0.0, 5e-6)),
-              ("wheel.unloaded_radius_m", "brake.gain_n_m_per_pa", *FRICTION), BRAKE_RUNS,
-              WHEEL, (),
-              (("radius_a_m_per_n2", "radius.a_m_per_n2"),
-               ("radius_b_m_per_n", "radius.b_m_per_n"))),
-    Candidate("friction_curve", None, FRICTION, (), ((0.05, 3.0), (1.0, 300.0), (0.0, 2.0)),
-              (), BRAKE_RUNS, WHEEL, (), tuple((k.split(".")[1], k) for k in FRICTION)),
+              free=("wheel.unloaded_radius_m", "brake.gain_n_m_per_pa", *FRICTION),
+              runs=BRAKE_RUNS, channels=WHEEL, held_out=(),
+              contract=(("radius_a_m_per_n2", "radius.a_m_per_n2"),
+                        ("radius_b_m_per_n", "radius.b_m_per_n"))),
+    Candidate(cause="friction_curve", element=None, keys=FRICTION, starts=(),
+              bounds=((0.05, 3.0), (1.0, 300.0), (0.0, 2.0)), free=(), runs=BRAKE_RUNS,
+              channels=WHEEL, held_out=(),
+              contract=tuple((k.split(".")[1], k) for k in FRICTION)),
 )}
 
 

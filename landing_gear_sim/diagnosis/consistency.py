@@ -29,17 +29,12 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
-import scipy.interpolate
 
 from landing_gear_sim.calibration import braking as br
-from landing_gear_sim.calibration.friction import friction_indices, samples_at
-from landing_gear_sim.calibration.measured import run_static_load_n
-from landing_gear_sim.calibration.runs import ClassifiedRun, RunKind
+from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.statistics import (
-    cluster_std,
     inverse_variance_weights,
     linear_std,
     weighted_least_squares,
@@ -51,6 +46,11 @@ from landing_gear_sim.calibration.wheel_angle import (
     brake_ripple,
 )
 from landing_gear_sim.diagnosis.findings import Finding
+from landing_gear_sim.diagnosis.load_relation import (
+    LOAD_SPREAD,
+    friction_in_load,
+)
+from landing_gear_sim.diagnosis.relations import MIN_SAMPLES, Check, Relation
 from landing_gear_sim.diagnosis.scoring import effective_count
 from landing_gear_sim.model.actuator import actuator_pressure
 from landing_gear_sim.model.parameters import RigParameters
@@ -59,64 +59,27 @@ from landing_gear_sim.model.scenario import logged_to_held
 from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.units import PA_PER_BAR
 
-Z_VIOLATED = 6.0  # σ: with a dozen checks per campaign, no false alarm from noise
 FORCE_FLOOR_N = 150.0  # a load-cell offset or crosstalk smaller than this does not matter
 PRESSURE_FLOOR_PA = 0.2 * PA_PER_BAR
 TREND_FLOOR = 0.05  # a brake gain changing by less than 5 % over the range does not matter
 SETTLED_S = 0.3  # after a current change the valve has settled
-MIN_SAMPLES = 200
 MIN_RUNS_FOR_DRIFT = 3
-FREE_ROLLING = "free rolling ⇒ F_x = J_w ω̇ / r"
-GAIN_IN_SPEED = "brake gain constant in speed"
-GAIN_IN_PRESSURE = "brake gain linear in pressure"
-RUN_DRIFT = "brake gain constant from run to run"
-VALVE_DIRECTION = "valve the same with the current rising and falling"
-FRICTION_IN_LOAD = "friction the same at every load"
-SLIP_KNOTS = 8  # inner knots of the free friction curve
-MIN_SLIP = 0.008  # below, a few hub-speed errors (0.01 m/s at the 3 m/s stop speed: 0.003)
-MAX_SLIP = 0.3  # beyond, a skidding wheel is on its way to lock, not on the steady curve
 MAX_BRAKING_SLIP = 0.15  # beyond, the torque balance's derivative error dominates
-LOAD_SPREAD = 0.05  # static loads closer than 5 % cannot show a law in load
-LOAD_UNIT_N = 1e4
-LOAD_FLOOR = 0.03  # μ changing by less than 3 % per 10 kN does not matter
-WHEEL_ANGLE = "wheel channel smooth in the wheel's angle"
 RUNOUT_FLOOR = 1e-3  # a ripple below 0.1 % of the wheel speed is within the encoder's noise
-PRESSURE_TIMING = "brake torque in step with the measured pressure"
 TIMING_FLOOR_S = 1e-3  # a channel out of step by less than a millisecond does not matter
-BRAKE_ANGLE = "brake torque smooth in the wheel's angle"
 BRAKE_RUNOUT_FLOOR = 0.01  # a disc's ripple below 1 % of the torque does not matter
 SLOW_A_S = 0.5  # slower current changes: A(s) errors leave no direction-locked residual
 
 
-@dataclass(frozen=True)
-class Check:
-    """One relation on one run (or the campaign) and phase: the deviation found, its 1-σ
-    and the floor below which it does not matter, in ``unit``."""
-
-    relation: str
-    run: str
-    phase: str
-    deviation: float
-    std: float
-    floor: float
-    unit: str
-
-    @property
-    def z(self) -> float:
-        return abs(self.deviation) / self.std if self.std > 0 else math.inf
-
-    @property
-    def violated(self) -> bool:
-        return self.z > Z_VIOLATED and abs(self.deviation) > self.floor
-
-    def describe(self) -> str:
-        return (f"{self.relation} ({self.run}, {self.phase}): {self.deviation:+.4g} {self.unit} "
-                f"± {self.std:.2g} ({self.z:.0f}σ)" + ("  VIOLATED" if self.violated else ""))
-
-    def to_json(self) -> dict[str, object]:
-        return {"relation": self.relation, "run": self.run, "phase": self.phase,
-                "deviation": self.deviation, "std": self.std, "floor": self.floor,
-                "unit": self.unit, "violated": self.violated}
+FREE_ROLLING = Relation.FREE_ROLLING
+GAIN_IN_SPEED = Relation.GAIN_IN_SPEED
+GAIN_IN_PRESSURE = Relation.GAIN_IN_PRESSURE
+RUN_DRIFT = Relation.RUN_DRIFT
+VALVE_DIRECTION = Relation.VALVE_DIRECTION
+FRICTION_IN_LOAD = Relation.FRICTION_IN_LOAD
+WHEEL_ANGLE = Relation.WHEEL_ANGLE
+PRESSURE_TIMING = Relation.PRESSURE_TIMING
+BRAKE_ANGLE = Relation.BRAKE_ANGLE
 
 
 def check_campaign(runs: Sequence[ClassifiedRun], params: RigParameters) -> list[Check]:
@@ -129,7 +92,7 @@ def check_campaign(runs: Sequence[ClassifiedRun], params: RigParameters) -> list
     if braking:
         checks.extend(_gain_trends(braking, params))
         checks.extend(_pressure_timing(braking, params))
-        checks.extend(_friction_in_load(braking, params))
+        checks.extend(friction_in_load(braking, params))
     return checks
 
 
@@ -144,48 +107,20 @@ def unchecked_relations(runs: Sequence[ClassifiedRun], checks: Sequence[Check]) 
             "friction changing with the load"]
 
 
-def violations(checks: Sequence[Check]) -> list[Check]:
-    """The violated checks, strongest first."""
-    return sorted((c for c in checks if c.violated), key=lambda c: -c.z)
-
-
 def inconsistent(broken: Sequence[Check]) -> Finding:
     """Violated relations as an ``unexplained`` finding (nothing in the model explains
     them): the strongest one's deviation, every one in the evidence, and the equation (or
     the channel's measurement) its relation checks."""
     best = broken[0]
-    equation, channel = where(best.relation)
-    return Finding("unexplained", {"deviation": best.deviation}, {"deviation": best.std},
-                   f"measured relations the model cannot break are violated, in the {equation}: "
-                   + "; ".join(c.describe() for c in broken[:4])
+    equation, channel = best.relation.equation, best.relation.channel
+    return Finding(cause="unexplained", parameters={"deviation": best.deviation},
+                   std={"deviation": best.std},
+                   evidence=f"measured relations the model cannot break are violated, in the "
+                   f"{equation}: " + "; ".join(c.describe() for c in broken[:4])
                    + (f"; and {len(broken) - 4} more" if len(broken) > 4 else ""),
-                   {}, {}, None, None, False, tuple(sorted({c.run for c in broken})), (),
-                   equation=equation, channel=channel)
-
-
-WHERE: dict[str, tuple[str, str]] = {
-    FREE_ROLLING: ("F_x channel", "longitudinal_force_n"),
-    "zero current ⇒ zero pressure": ("pressure channel", "pressure_pa"),
-    "no contact ⇒ no load": ("load cell", "vertical_load_n"),
-    GAIN_IN_SPEED: ("wheel", "longitudinal_force_n"),
-    GAIN_IN_PRESSURE: ("wheel", "longitudinal_force_n"),
-    RUN_DRIFT: ("wheel", "longitudinal_force_n"),
-    VALVE_DIRECTION: ("valve", "pressure_pa"),
-    FRICTION_IN_LOAD: ("wheel", "longitudinal_force_n"),
-    WHEEL_ANGLE: ("wheel channel", "wheel_speed_rad_s"),
-    PRESSURE_TIMING: ("pressure channel", "pressure_pa"),
-    BRAKE_ANGLE: ("wheel", "longitudinal_force_n"),
-}
-"""The equation (or channel measurement) each relation checks, and the channel it reads it
-in (the wheel's torque balance is read in the load cell's F_x)."""
-
-
-def where(relation: str) -> tuple[str, str]:
-    """The equation a relation checks and the channel that shows it."""
-    for name, place in WHERE.items():
-        if relation.startswith(name):
-            return place
-    return "model", ""
+                   fit_before={}, fit_after={}, delta_bic=None, held_out=None, accepted=False,
+                   fitted_on=tuple(sorted({c.run for c in broken})), equation=equation,
+                   channel=channel)
 
 
 def _run_checks(run: ClassifiedRun, prepared: br.Braking | None, params: RigParameters
@@ -196,8 +131,8 @@ def _run_checks(run: ClassifiedRun, prepared: br.Braking | None, params: RigPara
         checks.extend([_free_rolling(prepared, params), _wheel_angle(run, params),
                        _brake_angle(run, prepared, params)])
     else:
-        checks.extend(_mean_check("no contact ⇒ no load", run.name, "whole run",
-                                  getattr(run, name), FORCE_FLOOR_N, "N", label)
+        checks.extend(_mean_check(Relation.NO_CONTACT, run.name, f"whole run, {label}",
+                                  getattr(run, name), FORCE_FLOOR_N, "N")
                       for name, label in (("vertical_load_n", "F_z"),
                                           ("longitudinal_force_n", "F_x")))
         checks.append(_valve_direction(run, params))
@@ -255,13 +190,13 @@ def _brake_angle(run: ClassifiedRun, prepared: br.Braking, params: RigParameters
     return max(checks, key=lambda c: c.z)
 
 
-def _mean_check(relation: str, run: str, phase: str, values: np.ndarray, floor: float,
-                unit: str, label: str = "") -> Check | None:
+def _mean_check(relation: Relation, run: str, phase: str, values: np.ndarray, floor: float,
+                unit: str) -> Check | None:
     if values.size < MIN_SAMPLES:
         return None
     mean = float(np.mean(values))
     std = float(np.std(values)) / math.sqrt(effective_count(values - mean))
-    return Check(relation + (f": {label}" if label else ""), run, phase, mean, std, floor, unit)
+    return Check(relation, run, phase, mean, std, floor, unit)
 
 
 def _zero_current(run: ClassifiedRun, params: RigParameters) -> Check | None:
@@ -271,7 +206,7 @@ def _zero_current(run: ClassifiedRun, params: RigParameters) -> Check | None:
     samples = max(1, round(SETTLED_S * run.rate_hz))
     settled = np.convolve(off, np.ones(samples), mode="full")[:off.size] >= samples
     pressure = SensorModel.of(params).true_pressure(run.pressure_pa[settled])
-    return _mean_check("zero current ⇒ zero pressure", run.name, "current off", pressure,
+    return _mean_check(Relation.ZERO_CURRENT, run.name, "current off", pressure,
                        PRESSURE_FLOOR_PA, "Pa")
 
 
@@ -348,84 +283,6 @@ def _pressure_timing(runs: Sequence[br.Braking], params: RigParameters) -> list[
                   f"{MAX_BRAKING_SLIP:g}", lag, lag_std, TIMING_FLOOR_S, "s")]
 
 
-def _friction_in_load(runs: Sequence[br.Braking], params: RigParameters) -> list[Check]:
-    """μ = F_x/F_z (the model's load factor taken off) as a free curve in the measured slip
-    (cubic B-spline) times (1 + c (F_z − F̄_z)), over the slips that runs at a light and at
-    a heavy static load share: c, the relative change of μ per LOAD_UNIT_N of load.
-
-    Within a stop the load follows the speed (F_z0 − k_L v²), so a law in load and one in
-    speed read the same there, and where the light runs hold other slips than the heavy
-    ones, the free curve and the law trade: so only shared slips count, and only with ≥ 2
-    constant-pressure runs at each of two static loads LOAD_SPREAD apart. The curve is free,
-    not the model's (a calibration bends its curve to a law in load); the σ counts each run
-    once (cluster sandwich: what differs from run to run without a law in load is not
-    load)."""
-    per_run = [x for x in (_friction_run(b, params) for b in runs
-                           if b.run.kind is RunKind.BRAKE_CONSTANT) if x is not None]
-    shared = _shared_slips(per_run)
-    if shared is None:
-        return []
-    statics = np.array([static for *_, static in shared])
-    slip, mu, load = (np.concatenate([run[k] for run in shared]) for k in range(3))
-    curve = _slip_basis(slip)
-    shape, *_ = np.linalg.lstsq(curve, mu, rcond=None)
-    design = np.column_stack([curve, (load - load.mean()) / LOAD_UNIT_N * (curve @ shape)])
-    coef, *_ = np.linalg.lstsq(design, mu, rcond=None)
-    std = cluster_std(design, mu - design @ coef, [run[0].size for run in shared])
-    lo, hi = float(slip.min()), float(slip.max())
-    return [Check(FRICTION_IN_LOAD, "campaign",
-                  f"{len(shared)} constant-pressure runs at {statics.min() / 1e3:.3g}–"
-                  f"{statics.max() / 1e3:.3g} kN static load, slip {lo:.3f}–{hi:.3f}",
-                  float(coef[-1]), float(std[-1]), LOAD_FLOOR,
-                  f"of μ per {LOAD_UNIT_N / 1e3:g} kN")]
-
-
-Friction = tuple[np.ndarray, np.ndarray, np.ndarray, float]
-"""One run's slip, μ and F_z [N] on the steady friction curve, and its static load [N]."""
-
-
-def _shared_slips(per_run: Sequence[Friction]) -> list[Friction] | None:
-    """The runs cut to the slips (5-95 % of each group) that the light and the heavy runs
-    (static load below or above the middle of their range) share; None unless ≥ 2 runs of
-    each keep enough samples there."""
-    statics = np.array([static for *_, static in per_run])
-    if len(per_run) < 4 or np.ptp(statics) < LOAD_SPREAD * statics.mean():
-        return None
-    light = list(statics < (statics.min() + statics.max()) / 2)
-    slips = [np.concatenate([run[0] for run, lit in zip(per_run, light, strict=True)
-                             if lit == group]) for group in (True, False)]
-    lo = max(float(np.quantile(s, 0.05)) for s in slips)
-    hi = min(float(np.quantile(s, 0.95)) for s in slips)
-    kept, groups = [], []
-    for (slip, mu, load, static), lit in zip(per_run, light, strict=True):
-        inside = (slip >= lo) & (slip <= hi)
-        if inside.sum() >= MIN_SAMPLES // 4:
-            kept.append((slip[inside], mu[inside], load[inside], static))
-            groups.append(lit)
-    return kept if min(groups.count(True), groups.count(False)) >= 2 else None
-
-
-def _friction_run(b: br.Braking, params: RigParameters) -> Friction | None:
-    """One run's Friction on the steady curve (100 Hz, away from lock transients, where F_x
-    is not yet the steady μ(λ) F_z); None when it has too few samples."""
-    load = run_static_load_n(b.run, params)
-    i = friction_indices(b, params)
-    slip, mu = samples_at(b, params, i)
-    keep = (np.abs(b.wheel_rate[i]) < br.STEADY_RATE_RAD_S2) & (slip > MIN_SLIP) & (
-        slip < MAX_SLIP)
-    if load is None or keep.sum() < MIN_SAMPLES // 4:
-        return None
-    return slip[keep], mu[keep], b.load[i][keep], load
-
-
-def _slip_basis(slip: np.ndarray) -> np.ndarray:
-    """Cubic B-spline columns in the slip, knots at its quantiles, (n, k)."""
-    inner = np.quantile(slip, np.linspace(0.0, 1.0, SLIP_KNOTS + 2)[1:-1])
-    low, high = float(slip.min()), float(slip.max())
-    knots = np.concatenate([[low] * 4, inner, [high] * 4])
-    return scipy.interpolate.BSpline.design_matrix(slip, knots, 3).toarray()
-
-
 def _run_drift(per_run: Sequence[tuple[np.ndarray, np.ndarray]]) -> Check:
     """k_b of each run (T = k_b P, its 1-σ from the run's own residual), then a straight line
     through them in run order: the relative change from the first run to the last [1]. The
@@ -450,7 +307,7 @@ def _run_drift(per_run: Sequence[tuple[np.ndarray, np.ndarray]]) -> Check:
                  "of k_b")
 
 
-def _trend(relation: str, torque: np.ndarray, pressure: np.ndarray, variable: np.ndarray,
+def _trend(relation: Relation, torque: np.ndarray, pressure: np.ndarray, variable: np.ndarray,
            unit: str) -> Check:
     """T = k_b P (1 + β (x − x̄)/(x_max − x_min)): β is the relative change of the gain over
     the range of x seen."""

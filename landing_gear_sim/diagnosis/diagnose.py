@@ -32,16 +32,15 @@ from landing_gear_sim.diagnosis.catalogue import (
     switched_on,
 )
 from landing_gear_sim.diagnosis.consistency import (
-    Check,
     check_campaign,
     inconsistent,
     unchecked_relations,
-    violations,
 )
 from landing_gear_sim.diagnosis.equations import locate_all
 from landing_gear_sim.diagnosis.findings import Finding, Signature
 from landing_gear_sim.diagnosis.identifiability import actuator_calibrated, untestable
 from landing_gear_sim.diagnosis.local import LocalGain, local_gains
+from landing_gear_sim.diagnosis.relations import Check, violations
 from landing_gear_sim.diagnosis.scoring import (
     BIC_THRESHOLD,
     Scored,

@@ -1,58 +1,29 @@
-"""The discovered term a campaign calls for (issue 14), chosen and scored.
+"""The discovered term a campaign calls for (issues 14, 28, 29), chosen and scored.
 
-The relations the calibrated model violates say where to look
-(:mod:`~landing_gear_sim.diagnosis.consistency`); the libraries and candidates of
-:mod:`~landing_gear_sim.diagnosis.discovery` say what to try; each is scored exactly like a
-catalogue candidate. In round 1 the term the calibrated model calls for is also scored
-beside the catalogue's winners (:func:`rival`), so that a law the catalogue lacks is never
-reported under the name of a catalogued effect that bent to it.
+The relations a model violates and its residual signatures say where to look
+(:mod:`~landing_gear_sim.diagnosis.consistency`, :mod:`~landing_gear_sim.diagnosis.signatures`);
+the families of :mod:`~landing_gear_sim.diagnosis.families` say what to try, in the
+registry's order; each candidate is scored exactly like a catalogue candidate. The story
+(:class:`Story`) decides whether a discovered term replaces the catalogued causes, stands
+beside them, or is not sought at all.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
-from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.identify import Progress
 from landing_gear_sim.calibration.measured import CHANNELS, channels_of, simulate_all
 from landing_gear_sim.calibration.runs import ClassifiedRun
-from landing_gear_sim.diagnosis.catalogue import Candidate, Scales, scaled_error
-from landing_gear_sim.diagnosis.consistency import (
-    BRAKE_ANGLE,
-    FREE_ROLLING,
-    FRICTION_IN_LOAD,
-    GAIN_IN_PRESSURE,
-    GAIN_IN_SPEED,
-    LOAD_UNIT_N,
-    PRESSURE_TIMING,
-    RUN_DRIFT,
-    VALVE_DIRECTION,
-    WHEEL_ANGLE,
-    Check,
-    check_campaign,
-    violations,
-)
-from landing_gear_sim.diagnosis.discovery import (
-    backlash_candidate,
-    brake_runout_candidate,
-    channel_candidate,
-    discovered_candidate,
-    drift_candidate,
-    families,
-    load_candidate,
-    pressure_skew_candidate,
-    pressure_skew_start,
-    runout_candidate,
-    select_brake_runout_orders,
-    select_brake_terms,
-    select_channel_terms,
-    select_runout_orders,
-    skew_candidate,
-    term_formula,
-)
-from landing_gear_sim.diagnosis.findings import Finding, Signature, SignatureKind
+from landing_gear_sim.diagnosis.catalogue import Scales, scaled_error
+from landing_gear_sim.diagnosis.consistency import check_campaign
+from landing_gear_sim.diagnosis.families import REGISTRY, Evidence, Family, Proposal
+from landing_gear_sim.diagnosis.families.wheel_skew import wheel_lags
+from landing_gear_sim.diagnosis.findings import Finding, Signature
+from landing_gear_sim.diagnosis.relations import Check, violations
 from landing_gear_sim.diagnosis.scoring import (
     HELD_OUT_THRESHOLD,
     Scored,
@@ -67,93 +38,32 @@ from landing_gear_sim.model.parameters import RigParameters
 def discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: RigParameters,
               scales: Scales, signatures: Sequence[Signature], checks: Sequence[Check],
               say: Progress) -> Scored | None:
-    """A discovered term, scored, when relations among ``checks`` (of ``model``) are
-    violated and the sparse regression keeps a term, or the wheel channel lags the model
-    (None otherwise): the channels first (what they misread distorts the brake-gain
-    relations too), then the brake torque."""
-    broken = {c.relation for c in violations(checks)}
-    scored = None
-    excess = [c.deviation for c in violations(checks) if c.relation == VALVE_DIRECTION]
-    if excess and max(excess) > 0:  # the valve first: what it misreads reaches every run
-        scored = _score_discovered(backlash_candidate(max(excess), model), runs, model,
-                                   datasheet, scales, signatures, say)
-    late = [c.deviation for c in violations(checks) if c.relation == PRESSURE_TIMING]
-    if late and late[0] > 0 and (scored is None or not scored.finding.accepted):
-        scored = _score_discovered(pressure_skew_candidate(late[0], model), runs, model,
-                                   datasheet, scales, signatures, say,
-                                   pressure_skew_start(runs, model, late[0]))
-    if WHEEL_ANGLE in broken and (scored is None or not scored.finding.accepted):
-        orders = select_runout_orders(runs)
-        if orders:
-            scored = _score_discovered(runout_candidate(orders), runs, model, datasheet,
-                                       scales, signatures, say)
-    if BRAKE_ANGLE in broken and (scored is None or not scored.finding.accepted):
-        orders = select_brake_runout_orders(runs, model)
-        if orders:
-            scored = _score_discovered(brake_runout_candidate(orders), runs, model, datasheet,
-                                       scales, signatures, say)
-    lags = _wheel_lags(signatures)
-    if lags and (scored is None or not scored.finding.accepted):
-        scored = _score_discovered(skew_candidate(lags[0]), runs, model, datasheet, scales,
-                                   signatures, say)
-    libraries = {FREE_ROLLING, GAIN_IN_SPEED, GAIN_IN_PRESSURE}  # relations they explain
-    # filtered once for both libraries, and only when one of them will be asked
-    braking = [br.prepare(r, model) for r in runs if r.braking] if broken & libraries else []
-    if FREE_ROLLING in broken and (scored is None or not scored.finding.accepted):
-        channels = select_channel_terms(runs, braking, model)
-        if channels:
-            scored = _score_discovered(channel_candidate(channels), runs, model, datasheet,
-                                       scales, signatures, say)
-    if scored is None or not scored.finding.accepted:
-        for candidate in _gain_candidates(runs, braking, model, checks):
-            scored = _better(scored, _score_discovered(candidate, runs, model, datasheet,
-                                                       scales, signatures, say), runs)
-    friction = [c for c in violations(checks) if c.relation == FRICTION_IN_LOAD]
-    if friction and (scored is None or not scored.finding.accepted):
-        candidate = load_candidate(-friction[0].deviation / LOAD_UNIT_N, model)
-        scored = _better(scored, _score_discovered(candidate, runs, model, datasheet, scales,
-                                                   signatures, say), runs)
-    return None if scored is None else _called_for(scored, checks)
+    """A discovered term, scored, for what ``checks`` and ``signatures`` (of ``model``)
+    show, or None when no family is called for: the families of REGISTRY by rank, until
+    one rank accepts a term (of one rank's, the better is kept)."""
+    evidence = Evidence(runs, model, checks, signatures)
+    best: tuple[Family, Scored] | None = None
+    for _, group in itertools.groupby(REGISTRY, key=lambda f: f.rank):
+        if best is not None and best[1].finding.accepted:
+            break
+        for family in group:
+            for proposal in family.propose(evidence):
+                scored = _score_discovered(family, proposal, runs, model, datasheet, scales,
+                                           signatures, say)
+                if scored is not None and (best is None or _better(best[1], scored, runs)
+                                           is scored):
+                    best = (family, scored)
+    return None if best is None else _called_for(*best, evidence)
 
 
-CALLED_FOR = {"input_history": (VALVE_DIRECTION,), "wheel_angle": (WHEEL_ANGLE, BRAKE_ANGLE),
-              "channel_skew": (PRESSURE_TIMING,),
-              "channel_crosstalk": (FREE_ROLLING,), "run_drift": (RUN_DRIFT,),
-              "load": (FRICTION_IN_LOAD,)}
-"""The relations whose violation calls for each family (the brake-gain laws: their own)."""
-
-
-def _called_for(scored: Scored, checks: Sequence[Check]) -> Scored:
-    """The finding's evidence led by what called for it: the violated relations of its
-    family (up to two), or for a skew the wheel channel's lag."""
-    family = scored.finding.family
-    relations = CALLED_FOR.get(family, (GAIN_IN_SPEED, GAIN_IN_PRESSURE))
-    broken = [c.describe() for c in violations(checks) if c.relation in relations][:2]
-    reason = "; ".join(broken) or (
-        "the wheel channel lags the model's consistently (residual signature)"
-        if family == "channel_skew" else "")
+def _called_for(family: Family, scored: Scored, evidence: Evidence) -> Scored:
+    """The finding's evidence led by what called for its family."""
+    reason = family.reason(evidence)
     if not reason:
         return scored
     finding = replace(scored.finding, evidence=f"called for by {reason}; "
                       + scored.finding.evidence)
     return Scored(finding, scored.fit)
-
-
-def _gain_candidates(runs: Sequence[ClassifiedRun], braking: Sequence[br.Braking],
-                     model: RigParameters, checks: Sequence[Check]) -> list[Candidate]:
-    """The brake gain's law in speed and pressure, and its drift from run to run, as the
-    violated relations call for them: both are scored when both are (pressure levels in
-    run order make a drift look like a pressure law, and the reverse)."""
-    broken = {c.relation: c for c in reversed(violations(checks))}
-    candidates = []
-    if GAIN_IN_SPEED in broken or GAIN_IN_PRESSURE in broken:
-        terms = select_brake_terms(braking, model)
-        if terms:
-            candidates.append(discovered_candidate(terms))
-    if RUN_DRIFT in broken:
-        candidates.append(drift_candidate(broken[RUN_DRIFT].deviation,
-                                          sum(r.braking for r in runs)))
-    return candidates
 
 
 def _better(first: Scored | None, second: Scored | None,
@@ -216,7 +126,7 @@ class Story:
             return None if found is None else Extension(
                 [found.finding], [], found if found.finding.accepted else None)
         signatures = find_signatures(self.runs, model, simulate_all(self.runs, model))
-        if not violations(checks) and not _wheel_lags(signatures):
+        if not violations(checks) and not wheel_lags(signatures):
             return None
         tried = []
         rival = self._discover(self.calibrated, self.checks, self.signatures)
@@ -241,12 +151,6 @@ class Story:
 
 def _causes(accepted: Sequence[Scored]) -> str:
     return ", ".join(s.finding.cause for s in accepted)
-
-
-def _wheel_lags(signatures: Sequence[Signature]) -> list[float]:
-    """The wheel channel's consistent lags behind the model (later: positive)."""
-    return [s.value for s in signatures if s.kind is SignatureKind.LAG
-            and s.channel == "wheel_speed_rad_s" and s.value > 0]
 
 
 GIVE_BACK = 0.1
@@ -282,15 +186,15 @@ def explains_more(rival: Scored, accepted: Sequence[Scored], model: RigParameter
         and sum(changes) < HELD_OUT_THRESHOLD
 
 
-def _score_discovered(candidate: Candidate, runs: Sequence[ClassifiedRun],
+def _score_discovered(family: Family, proposal: Proposal, runs: Sequence[ClassifiedRun],
                       model: RigParameters, datasheet: RigParameters, scales: Scales,
-                      signatures: Sequence[Signature], say: Progress,
-                      start: RigParameters | None = None) -> Scored | None:
-    say(f"fitting a discovered term: {families(candidate)}")
+                      signatures: Sequence[Signature], say: Progress) -> Scored | None:
+    candidate = proposal.candidate
+    say(f"fitting a discovered term: {candidate.family}")
     try:
-        scored = score_candidate(candidate, runs, model, datasheet, scales, signatures, start)
+        scored = score_candidate(candidate, runs, model, datasheet, scales, signatures,
+                                 proposal.start)
     except IdentificationError:
         return None
-    finding = replace(scored.finding, family=families(candidate),
-                      term=term_formula(candidate, scored.fit.params))
+    finding = replace(scored.finding, term=family.formula(candidate, scored.fit.params))
     return Scored(finding, scored.fit)

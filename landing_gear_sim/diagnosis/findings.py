@@ -23,7 +23,7 @@ class SignatureKind(str, enum.Enum):
             self.value]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Finding:
     """One cause (or unexplained structure) with its evidence.
 

@@ -140,14 +140,15 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
                 and not at_bound and not beyond)
     parameters = key_parameters(candidate, with_it.params)
     std = key_std(candidate, with_it)
-    finding = Finding(candidate.cause, parameters, std,
-                      _evidence(candidate, delta_bic, held_delta, before, after, fit_runs,
-                                held_runs, signatures)
-                      + ("; a key parameter sits at the edge of its range" if at_bound else "")
-                      + (f"; not accepted: {beyond}" if beyond else ""),
-                      before, after, round(delta_bic, 1),
-                      None if held_delta is None else round(held_delta, 1), accepted,
-                      _names(fit_runs), _names(held_runs))
+    evidence = _evidence(candidate, delta_bic, held_delta, before, after, fit_runs, held_runs,
+                         signatures) \
+        + ("; a key parameter sits at the edge of its range" if at_bound else "") \
+        + (f"; not accepted: {beyond}" if beyond else "")
+    finding = Finding(cause=candidate.cause, parameters=parameters, std=std, evidence=evidence,
+                      fit_before=before, fit_after=after, delta_bic=round(delta_bic, 1),
+                      held_out=None if held_delta is None else round(held_delta, 1),
+                      accepted=accepted, fitted_on=_names(fit_runs),
+                      checked_on=_names(held_runs), family=candidate.family)
     return Scored(finding, with_it)
 
 

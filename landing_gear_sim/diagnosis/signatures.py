@@ -199,10 +199,11 @@ def unexplained(signatures: Sequence[Signature], baseline: dict[str, float],
     words = [s.describe() + (f" — {place.describe()}" if place else "")
              for s, place in zip(signatures[:3], where, strict=False)]
     equation = where[0].equation.value if where[0] else _channel_equation(best.channel)
-    return Finding("unexplained", {best.kind.parameter: round(best.value, 6)}, {},
-                   "no candidate of the catalogue explains: " + "; ".join(words),
-                   baseline, baseline, None, None, False, best.runs, (),
-                   equation=equation, channel=best.channel)
+    return Finding(cause="unexplained", parameters={best.kind.parameter: round(best.value, 6)},
+                   std={}, evidence="no candidate of the catalogue explains: "
+                   + "; ".join(words), fit_before=baseline, fit_after=baseline, delta_bic=None,
+                   held_out=None, accepted=False, fitted_on=best.runs, equation=equation,
+                   channel=best.channel)
 
 
 def _channel_equation(channel: str) -> str:

@@ -50,6 +50,18 @@ def _f(key: str, unit: str, description: str, positive: bool = True) -> ParamSpe
     return ParamSpec(key, unit, description, positive=positive)
 
 
+def _ripple(prefix: str, law: str, cause: str, read_from: str) -> tuple[ParamSpec, ...]:
+    """A ripple with the wheel's angle once and twice per revolution: per order its
+    relative amplitude and its phase at the run's first sample."""
+    return tuple(spec for order in (1, 2) for spec in (
+        ParamSpec(f"{prefix}_{order}", "-",
+                  f"{law} (1 + e cos({order} theta + phi)): a ripple {order}x per wheel "
+                  f"revolution, relative ({cause}; 0: none)", default=0.0),
+        ParamSpec(f"{prefix}_{order}_phase_rad", "rad",
+                  "phase phi of that ripple at the run's first sample (theta = 0 there; a "
+                  f"measured run's own is read from {read_from})", signed=True, default=0.0)))
+
+
 SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("configuration", "-", "rig (flywheel) or aircraft (eqs. 5-6)", "choice",
               choices=CONFIGURATIONS),
@@ -145,15 +157,8 @@ SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("friction.reference_load_n", "N",
               "vertical load at which the friction curve mu_B holds (0: at "
               "loading.static_load_n); a run at another static load keeps it", default=0.0),
-    *(spec for order in (1, 2) for spec in (
-        ParamSpec(f"sensors.wheel_runout_{order}", "-",
-                  f"the wheel encoder reads omega (1 + e cos({order} theta + phi)): a ripple "
-                  f"{order}x per wheel revolution, relative (run-out, an out-of-round code "
-                  "wheel; 0: none)", default=0.0),
-        ParamSpec(f"sensors.wheel_runout_{order}_phase_rad", "rad",
-                  "phase phi of that ripple at the run's first sample (theta = 0 there; a "
-                  "measured run's own is read from its wheel channel)", signed=True,
-                  default=0.0))),
+    *_ripple("sensors.wheel_runout", "the wheel encoder reads omega", "run-out, an "
+             "out-of-round code wheel", "its wheel channel"),
     ParamSpec("brake.fade_shape", "-",
               "shape s of the fade (brake_fade): k_b (1 - fraction g(E/energy)), g(x) = 1 - (1 + "
               "s x)^(-1/s); 0: the exponential 1 - exp(-x), 1: the hyperbola x/(1 + x); the "
@@ -161,15 +166,8 @@ SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("sensors.pressure_delay_s", "s",
               "the pressure channel reads the pressure this much earlier than the others are "
               "read (a logger channel out of step; 0: none)", default=0.0),
-    *(spec for order in (1, 2) for spec in (
-        ParamSpec(f"brake.runout_{order}", "-",
-                  f"the brake torque is k_b P (1 + e cos({order} theta + phi)): a ripple "
-                  f"{order}x per wheel revolution, relative (disc run-out, thickness "
-                  "variation; 0: none)", default=0.0),
-        ParamSpec(f"brake.runout_{order}_phase_rad", "rad",
-                  "phase phi of that ripple at the run's first sample (theta = 0 there; a "
-                  "measured run's own is read from its torque balance)", signed=True,
-                  default=0.0))),
+    *_ripple("brake.runout", "the brake torque is k_b P", "a disc's run-out, thickness "
+             "variation", "its torque balance"),
 )
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}

@@ -12,8 +12,8 @@ import matplotlib.ticker
 import numpy as np
 
 from landing_gear_sim.calibration.measured import CHANNELS
-from landing_gear_sim.diagnosis.consistency import Z_VIOLATED, Check
 from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
+from landing_gear_sim.diagnosis.relations import Z_VIOLATED, Check
 from landing_gear_sim.diagnosis.residuals import Spectrum
 from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, HELD_OUT_THRESHOLD
 from landing_gear_sim.report.figures import DISPLAY_UNITS, save_figure

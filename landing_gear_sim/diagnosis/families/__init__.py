@@ -1,0 +1,52 @@
+"""Families of terms the catalogue lacks, as plug-ins (issue 29): one module per family, an
+ordered registry.
+
+Each family (:class:`~.base.Family`) extends one equation of the rig's model — the valve,
+the wheel's torque balance, a channel's measurement — by a term held in a slot of the model,
+says which violated relations call for it, proposes candidates from what the campaign shows
+and writes its law with the fitted values; it also says how to hide its effect in a
+generated campaign, so that the tests and the benchmark parametrise over :data:`REGISTRY`.
+The diagnosis tries them in this order (:func:`~..discovered.discover`): the valve and the
+channels first, since what they misread distorts every other relation, then the wheel's
+equation. Adding a family: one module here, its slot in the model, its line below.
+"""
+
+from __future__ import annotations
+
+from landing_gear_sim.diagnosis.families import (
+    channel_crosstalk,
+    disc_runout,
+    encoder_ripple,
+    gain_law,
+    input_history,
+    load,
+    pressure_skew,
+    run_drift,
+    wheel_skew,
+)
+from landing_gear_sim.diagnosis.families.base import (
+    DISCOVERED,
+    Evidence,
+    Family,
+    Hidden,
+    Proposal,
+)
+
+REGISTRY: tuple[Family, ...] = tuple(sorted((
+    input_history.FAMILY,
+    pressure_skew.FAMILY,
+    encoder_ripple.FAMILY,
+    disc_runout.FAMILY,
+    wheel_skew.FAMILY,
+    channel_crosstalk.FAMILY,
+    gain_law.FAMILY,
+    run_drift.FAMILY,
+    load.FAMILY,
+), key=lambda f: f.rank))
+"""Every family, in the order the diagnosis tries them (by rank; one rank: in this order)."""
+
+HIDDEN: dict[str, tuple[Family, Hidden]] = {
+    h.name: (f, h) for f in REGISTRY for h in f.hidden}
+"""Every family's hidden effects by case name (tests, bench/detection.py)."""
+
+__all__ = ["DISCOVERED", "HIDDEN", "REGISTRY", "Evidence", "Family", "Hidden", "Proposal"]

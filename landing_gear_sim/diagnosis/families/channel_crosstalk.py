@@ -1,0 +1,111 @@
+"""``channel_crosstalk``: the load cell's F_x channel carrying another channel, in its
+measurement equation (issue 14).
+
+Called for by the relation "free rolling ⇒ F_x = J_w ω̇ / r": what the F_x channel reads
+where the true F_x is known — before braking (the wheel's inertia force) and off the ground
+(0) — is regressed on the channel library by a sparse solver (BIC).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
+from landing_gear_sim.diagnosis.consistency import FORCE_FLOOR_N, Relation, free_rolling_excess
+from landing_gear_sim.diagnosis.families.base import (
+    DECIMATE,
+    Evidence,
+    Family,
+    Hidden,
+    Proposal,
+    sparse_coefficients,
+    term_candidate,
+)
+from landing_gear_sim.model.parameters import RigParameters
+
+FRACTION_BOUND = 0.1  # of the other channel at most
+
+
+@dataclass(frozen=True)
+class ChannelTerm:
+    """Another measured channel the F_x channel may carry: its slot (a fraction), symbol
+    and values."""
+
+    key: str
+    symbol: str
+    values: Callable[[ClassifiedRun], np.ndarray]
+
+
+LIBRARY = (ChannelTerm("sensors.crosstalk_fx_per_fz", "F_z", lambda r: r.vertical_load_n),)
+
+
+class ChannelCrosstalk(Family):
+    name = "channel_crosstalk"
+    reports = "channel_crosstalk"
+    equation = "F_x channel"
+    keys = tuple(t.key for t in LIBRARY)
+    relations = (Relation.FREE_ROLLING,)
+    rank = 5
+    hidden = (Hidden("channel_crosstalk", "channel_crosstalk", lambda rng, datasheet: {
+        "sensors.crosstalk_fx_per_fz": rng.choice([-1, 1]) * rng.uniform(0.008, 0.03)},
+        "sensors.crosstalk_fx_per_fz", "crosstalk_fx_per_fz", 0.1),)
+
+    def propose(self, evidence: Evidence) -> list[Proposal]:
+        """The kept channels, fitted with what a crosstalk distorts in the calibration (the
+        brake gain of the torque balance, the friction curve of μ = F_x/F_z, the flywheel
+        inertia and drag of its momentum balance: without the drag the fraction came out 9 %
+        high)."""
+        if not evidence.violated(Relation.FREE_ROLLING):
+            return []
+        terms = select_terms(evidence.runs, evidence.braking, evidence.model)
+        if not terms:
+            return []
+        free = ("brake.gain_n_m_per_pa", "flywheel.inertia_kg_m2", "drag.coeff_n_s2_per_m2",
+                *FRICTION)
+        return [Proposal(term_candidate(
+            self, [t.key for t in terms], list(terms.values()),
+            [(-FRACTION_BOUND, FRACTION_BOUND)] * len(terms), free, BRAKE_RUNS,
+            (*WHEEL, "flywheel_speed_rad_s")))]
+
+    def formula(self, candidate: Candidate, params: RigParameters) -> str:
+        kept = [t for t in LIBRARY if t.key in candidate.keys]
+        return "F_x,read = F_x " + " ".join(
+            f"{'+' if v >= 0 else '−'} {abs(v):.4g}·{t.symbol}"
+            for t, v in ((t, params.number(t.key)) for t in kept))
+
+
+def select_terms(runs: Sequence[ClassifiedRun], braking: Sequence[br.Braking],
+                 params: RigParameters) -> dict[ChannelTerm, float]:
+    """The channels the F_x channel carries, with their fractions, where the true F_x is
+    known: before braking (``braking``: the braking runs prepared) and off the ground (the
+    other ``runs``); sparse regression, BIC; kept when they move F_x by more than the
+    consistency floor."""
+    excess, columns = [], []
+    for b in braking:
+        mask, y = free_rolling_excess(b, params)
+        excess.append(y[::DECIMATE])
+        columns.append(_channels(b.run, mask))
+    for run in runs:
+        if not run.braking:
+            excess.append(run.longitudinal_force_n[::DECIMATE])
+            columns.append(_channels(run, np.ones(len(run), dtype=bool)))
+    y, x = np.concatenate(excess), np.vstack(columns)
+    if y.size < 4 * len(LIBRARY):
+        return {}
+    fractions = sparse_coefficients(x, y)
+    return {term: float(c) for term, c, top in zip(LIBRARY, fractions,
+                                                   np.max(np.abs(x), axis=0), strict=True)
+            if abs(c) * top > FORCE_FLOOR_N}
+
+
+def _channels(run: ClassifiedRun, mask: np.ndarray) -> np.ndarray:
+    """The library's channels of ``run`` at ``mask``, decimated, shape (m, k)."""
+    return np.column_stack([t.values(run)[mask] for t in LIBRARY])[::DECIMATE]
+
+
+FAMILY = ChannelCrosstalk()

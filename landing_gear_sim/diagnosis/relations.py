@@ -1,0 +1,92 @@
+"""The relations the rig measures twice, as values: which relation, and one check of it on a
+run (or the campaign) against its noise and its physical floor. The checks themselves are in
+:mod:`~landing_gear_sim.diagnosis.consistency`."""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+Z_VIOLATED = 6.0  # σ: with a dozen checks per campaign, no false alarm from noise
+MIN_SAMPLES = 200  # a check on fewer samples is not made
+
+
+class Relation(str, enum.Enum):
+    """A relation the rig measures twice, by its display text (compares equal to it), with
+    the equation (or channel measurement) it checks and the channel that shows it."""
+
+    FREE_ROLLING = "free rolling ⇒ F_x = J_w ω̇ / r"
+    ZERO_CURRENT = "zero current ⇒ zero pressure"
+    NO_CONTACT = "no contact ⇒ no load"
+    GAIN_IN_SPEED = "brake gain constant in speed"
+    GAIN_IN_PRESSURE = "brake gain linear in pressure"
+    RUN_DRIFT = "brake gain constant from run to run"
+    VALVE_DIRECTION = "valve the same with the current rising and falling"
+    FRICTION_IN_LOAD = "friction the same at every load"
+    WHEEL_ANGLE = "wheel channel smooth in the wheel's angle"
+    PRESSURE_TIMING = "brake torque in step with the measured pressure"
+    BRAKE_ANGLE = "brake torque smooth in the wheel's angle"
+
+    def __str__(self) -> str:
+        return self.value
+
+    @property
+    def equation(self) -> str:
+        """The equation, or the channel's measurement, the relation checks."""
+        return _WHERE[self.name][0]
+
+    @property
+    def channel(self) -> str:
+        """The measured channel a violation shows in (the wheel's torque balance: F_x)."""
+        return _WHERE[self.name][1]
+
+
+_WHERE = {
+    "FREE_ROLLING": ("F_x channel", "longitudinal_force_n"),
+    "ZERO_CURRENT": ("pressure channel", "pressure_pa"),
+    "NO_CONTACT": ("load cell", "vertical_load_n"),
+    "GAIN_IN_SPEED": ("wheel", "longitudinal_force_n"),
+    "GAIN_IN_PRESSURE": ("wheel", "longitudinal_force_n"),
+    "RUN_DRIFT": ("wheel", "longitudinal_force_n"),
+    "VALVE_DIRECTION": ("valve", "pressure_pa"),
+    "FRICTION_IN_LOAD": ("wheel", "longitudinal_force_n"),
+    "WHEEL_ANGLE": ("wheel channel", "wheel_speed_rad_s"),
+    "PRESSURE_TIMING": ("pressure channel", "pressure_pa"),
+    "BRAKE_ANGLE": ("wheel", "longitudinal_force_n"),
+}
+@dataclass(frozen=True)
+class Check:
+    """One relation on one run (or the campaign) and phase: the deviation found, its 1-σ
+    and the floor below which it does not matter, in ``unit``."""
+
+    relation: Relation
+    run: str
+    phase: str
+    deviation: float
+    std: float
+    floor: float
+    unit: str
+
+    @property
+    def z(self) -> float:
+        return abs(self.deviation) / self.std if self.std > 0 else math.inf
+
+    @property
+    def violated(self) -> bool:
+        return self.z > Z_VIOLATED and abs(self.deviation) > self.floor
+
+    def describe(self) -> str:
+        return (f"{self.relation} ({self.run}, {self.phase}): {self.deviation:+.4g} {self.unit} "
+                f"± {self.std:.2g} ({self.z:.0f}σ)" + ("  VIOLATED" if self.violated else ""))
+
+    def to_json(self) -> dict[str, object]:
+        return {"relation": self.relation, "run": self.run, "phase": self.phase,
+                "deviation": self.deviation, "std": self.std, "floor": self.floor,
+                "unit": self.unit, "violated": self.violated}
+
+
+def violations(checks: Sequence[Check]) -> list[Check]:
+    """The violated checks, strongest first."""
+    return sorted((c for c in checks if c.violated), key=lambda c: -c.z)

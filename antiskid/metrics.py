@@ -57,7 +57,7 @@ class BrakingMetrics:
 
 def braking_window(run: Run) -> slice:
     """From the first brake command (scenario.brake_start_index) to the end of the run."""
-    start = brake_start_index(run.current_a)
+    start = brake_start_index(run.current_a, run.rate_hz)
     if start is None or float(np.max(run.vertical_load_n)) < MIN_LOAD_N:
         raise LandingGearSimError(f"{run.name}: not a braking run (no current, or the wheel "
                                   "never touches the flywheel)")

@@ -139,10 +139,14 @@ class ClassifiedRun(Run):
 
         The valve was driven by the command, not by the logger's noise; fed to the model,
         that noise is errors-in-variables within the valve's bandwidth, where wheel-lock
-        events are sensitive to it (:func:`~landing_gear_sim.model.scenario.denoised_command`).
-        Actuator runs (sweeps up to 100 Hz, which a median would flatten) keep the log.
+        events are sensitive to it (:func:`~landing_gear_sim.model.scenario.denoised_command`),
+        and a valve with play follows it (10 mA of noise kicked the play operator back and
+        forth on a quasi-static ramp). Dynamic actuator runs (sweeps up to 100 Hz, which a
+        median would flatten) keep the log.
         """
-        return denoised_command(self.current_a)[0] if self.braking else self.current_a
+        if self.kind is RunKind.ACTUATOR_DYNAMIC:
+            return self.current_a
+        return denoised_command(self.current_a, self.rate_hz)[0]
 
 
 def on_uniform_grid(run: Run) -> Run:
@@ -229,7 +233,7 @@ def _fastest_change_a_s(run: Run) -> float:
 
 def brake_start_s(run: Run) -> float:
     """Time of the first brake command (or the run's end if never) [s, run clock]."""
-    index = brake_start_index(run.current_a)
+    index = brake_start_index(run.current_a, run.rate_hz)
     return float(run.time_s[-1] if index is None else run.time_s[index])
 
 

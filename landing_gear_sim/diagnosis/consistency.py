@@ -31,9 +31,10 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
+import scipy.signal
 
 from landing_gear_sim.calibration import braking as br
-from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.calibration.runs import ClassifiedRun, RunKind
 from landing_gear_sim.calibration.statistics import (
     inverse_variance_weights,
     linear_std,
@@ -50,12 +51,17 @@ from landing_gear_sim.diagnosis.load_relation import (
     LOAD_SPREAD,
     friction_in_load,
 )
-from landing_gear_sim.diagnosis.relations import MIN_SAMPLES, Check, Relation
+from landing_gear_sim.diagnosis.relations import MIN_CHECK_S, MIN_SAMPLES, Check, Relation
 from landing_gear_sim.diagnosis.scoring import effective_count
 from landing_gear_sim.model.actuator import actuator_pressure
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rolling_radius_at
-from landing_gear_sim.model.scenario import logged_to_held
+from landing_gear_sim.model.scenario import (
+    NOISY_CURRENT_A,
+    commanded,
+    current_noise_a,
+    logged_to_held,
+)
 from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.units import PA_PER_BAR
 
@@ -69,6 +75,10 @@ RUNOUT_FLOOR = 1e-3  # a ripple below 0.1 % of the wheel speed is within the enc
 TIMING_FLOOR_S = 1e-3  # a channel out of step by less than a millisecond does not matter
 BRAKE_RUNOUT_FLOOR = 0.01  # a disc's ripple below 1 % of the torque does not matter
 SLOW_A_S = 0.5  # slower current changes: A(s) errors leave no direction-locked residual
+RATE_WINDOW_S = 0.3  # a noisy current's rate of change is its slope over this ...
+RATE_NOISE_Z = 5.0  # ... and counted beyond this many σ of that average's noise
+NOISE_WINDOW_S = 0.5  # a current log's noise is read in pieces this long ...
+NOISE_QUANTILE = 0.2  # ... as this quantile of the pieces' estimates
 
 
 FREE_ROLLING = Relation.FREE_ROLLING
@@ -132,7 +142,7 @@ def _run_checks(run: ClassifiedRun, prepared: br.Braking | None, params: RigPara
                        _brake_angle(run, prepared, params)])
     else:
         checks.extend(_mean_check(Relation.NO_CONTACT, run.name, f"whole run, {label}",
-                                  getattr(run, name), FORCE_FLOOR_N, "N")
+                                  getattr(run, name), FORCE_FLOOR_N, "N", run.rate_hz)
                       for name, label in (("vertical_load_n", "F_z"),
                                           ("longitudinal_force_n", "F_x")))
         checks.append(_valve_direction(run, params))
@@ -144,23 +154,54 @@ def _valve_direction(run: ClassifiedRun, params: RigParameters) -> Check | None:
     last (only where it has changed slowly for SETTLED_S and the valve is between its
     dead-band and saturation): a static map cannot tell the two apart, a valve with play
     can. Positive: more pressure on the way down."""
-    model = actuator_pressure(params, logged_to_held(run.current_a), run.rate_hz)
+    model = actuator_pressure(params, logged_to_held(run.command_a), run.rate_hz)
     residual = run.pressure_pa - SensorModel.of(params).pressure_channel(run.time_s, model)
-    change = np.diff(run.current_a, prepend=run.current_a[0])
+    change = _current_rate(run)
     last = np.maximum.accumulate(np.where(change != 0.0, np.arange(change.size), 0))
     direction = np.sign(change[last])
     window = max(1, round(SETTLED_S * run.rate_hz))
-    fast = np.abs(change) * run.rate_hz > SLOW_A_S
+    fast = np.abs(change) > SLOW_A_S
     slow = np.convolve(fast, np.ones(window), mode="full")[:fast.size] == 0
     band = (model > 2 * PRESSURE_FLOOR_PA) & (model < 0.9 * params.number(
         "actuator.max_pressure_pa"))
     falling, rising = (residual[slow & band & (direction == s)] for s in (-1.0, 1.0))
-    if min(falling.size, rising.size) < MIN_SAMPLES:
+    if min(falling.size, rising.size) < MIN_CHECK_S * run.rate_hz or _unreadable(run):
         return None
     std = math.sqrt(sum(float(np.var(r)) / effective_count(r - r.mean())
                         for r in (falling, rising)))
     return Check(VALVE_DIRECTION, run.name, "slow current changes",
                  float(falling.mean() - rising.mean()), std, PRESSURE_FLOOR_PA, "Pa")
+
+
+def _unreadable(run: ClassifiedRun) -> bool:
+    """A fast actuator run whose current log is noisy: fed the log (a sweep to 100 Hz keeps
+    it), a valve with play follows the noise both ways, and which way the current last
+    moved means nothing (the quasi-static ramp, fed its denoised command, still tells)."""
+    return run.kind is RunKind.ACTUATOR_DYNAMIC and _log_noise_a(run) > NOISY_CURRENT_A
+
+
+def _log_noise_a(run: ClassifiedRun) -> float:
+    """The current log's noise where the command is quietest [A]: a low quantile of the
+    estimate over NOISE_WINDOW_S pieces (a clean log's 100 Hz sweep read as 1.2 mA of
+    'noise' over the whole run, and the run went unchecked)."""
+    width = max(MIN_SAMPLES, round(NOISE_WINDOW_S * run.rate_hz))
+    pieces = [run.current_a[i:i + width] for i in range(0, run.current_a.size, width)]
+    return float(np.quantile([current_noise_a(p) for p in pieces], NOISE_QUANTILE))
+
+
+def _current_rate(run: ClassifiedRun) -> np.ndarray:
+    """How fast the valve's current changes [A/s], (n,); 0 where it holds. A noisy log's
+    rate is the least-squares slope over RATE_WINDOW_S, counted only beyond RATE_NOISE_Z
+    times that slope's noise (10 mA of noise made every sample a 'fast change' on its own,
+    and the relation went unchecked)."""
+    noise = _log_noise_a(run)
+    if noise <= NOISY_CURRENT_A:
+        return np.diff(run.current_a, prepend=run.current_a[0]) * run.rate_hz
+    width = 2 * round(RATE_WINDOW_S * run.rate_hz / 2) + 1
+    slope = scipy.signal.savgol_filter(run.current_a, width, 1, deriv=1,
+                                       delta=1.0 / run.rate_hz, mode="nearest")
+    floor = RATE_NOISE_Z * noise * run.rate_hz * math.sqrt(12.0 / width ** 3)
+    return np.where(np.abs(slope) > floor, slope, 0.0)
 
 
 def _wheel_angle(run: ClassifiedRun, params: RigParameters) -> Check | None:
@@ -191,8 +232,8 @@ def _brake_angle(run: ClassifiedRun, prepared: br.Braking, params: RigParameters
 
 
 def _mean_check(relation: Relation, run: str, phase: str, values: np.ndarray, floor: float,
-                unit: str) -> Check | None:
-    if values.size < MIN_SAMPLES:
+                unit: str, rate_hz: float) -> Check | None:
+    if values.size < MIN_CHECK_S * rate_hz:
         return None
     mean = float(np.mean(values))
     std = float(np.std(values)) / math.sqrt(effective_count(values - mean))
@@ -200,14 +241,16 @@ def _mean_check(relation: Relation, run: str, phase: str, values: np.ndarray, fl
 
 
 def _zero_current(run: ClassifiedRun, params: RigParameters) -> Check | None:
-    """Pressure where the current has been zero for SETTLED_S (before braking, between
-    pulses): a valve that is shut holds no pressure (the model's sensor offset aside)."""
-    off = run.current_a <= 0.0
+    """Pressure where the current has commanded nothing for SETTLED_S (before braking,
+    between pulses): a valve that is shut holds no pressure (the model's sensor offset
+    aside). 'Nothing' as the brake's start reads it: a noisy, quantised log's current is
+    never exactly 0."""
+    off = ~commanded(run.current_a, run.rate_hz)
     samples = max(1, round(SETTLED_S * run.rate_hz))
     settled = np.convolve(off, np.ones(samples), mode="full")[:off.size] >= samples
     pressure = SensorModel.of(params).true_pressure(run.pressure_pa[settled])
     return _mean_check(Relation.ZERO_CURRENT, run.name, "current off", pressure,
-                       PRESSURE_FLOOR_PA, "Pa")
+                       PRESSURE_FLOOR_PA, "Pa", run.rate_hz)
 
 
 def free_rolling_excess(b: br.Braking, params: RigParameters) -> tuple[np.ndarray, np.ndarray]:
@@ -224,7 +267,8 @@ def free_rolling_excess(b: br.Braking, params: RigParameters) -> tuple[np.ndarra
 
 def _free_rolling(b: br.Braking, params: RigParameters) -> Check | None:
     _, excess = free_rolling_excess(b, params)
-    return _mean_check(FREE_ROLLING, b.run.name, "before braking", excess, FORCE_FLOOR_N, "N")
+    return _mean_check(FREE_ROLLING, b.run.name, "before braking", excess, FORCE_FLOOR_N, "N",
+                       b.run.rate_hz)
 
 
 def _gain_trends(runs: Sequence[br.Braking], params: RigParameters) -> list[Check]:

@@ -144,7 +144,9 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     simulated_before = simulate_all(runs, calibrated)
     baseline = baseline_fits(runs, simulated_before)
     say("analysing the residuals of the calibrated model")
-    before = _interpretable(find_signatures(runs, calibrated, simulated_before), runs)
+    tried = _interpretable(find_signatures(runs, calibrated, simulated_before, tentative=True),
+                           runs)
+    before = [s for s in tried if not s.tentative]
     scales = noise_scales(runs, tuple(CHANNELS))
     pending, skipped = _testable(candidates_for(start, without), runs, problems, say)
     model = calibrated
@@ -175,7 +177,7 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     checks = check_campaign(runs, model)
     calibrated_checks = checks if model is calibrated else check_campaign(runs, calibrated)
     problems.extend(unchecked_relations(runs, calibrated_checks))
-    story = discovered.Story(runs, calibrated, base, scales, before, calibrated_checks, say)
+    story = discovered.Story(runs, calibrated, base, scales, tried, calibrated_checks, say)
     found = story.extend(accepted, model, checks)
     if found is not None:
         table.extend(found.tried)

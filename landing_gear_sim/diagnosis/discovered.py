@@ -125,7 +125,8 @@ class Story:
             found = self._discover(self.calibrated, self.checks, self.signatures)
             return None if found is None else Extension(
                 [found.finding], [], found if found.finding.accepted else None)
-        signatures = find_signatures(self.runs, model, simulate_all(self.runs, model))
+        signatures = find_signatures(self.runs, model, simulate_all(self.runs, model),
+                                     tentative=True)
         if not violations(checks) and not wheel_lags(signatures):
             return None
         tried = []

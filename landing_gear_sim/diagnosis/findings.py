@@ -83,6 +83,8 @@ class Signature:
     size: float
     runs: tuple[str, ...]
     regressor: str = ""
+    tentative: bool = False
+    """Too scattered over the runs to report, enough to try a candidate for."""
 
     def describe(self) -> str:
         where = f"{self.channel} residual in {len(self.runs)} runs"

@@ -10,7 +10,9 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 Z_VIOLATED = 6.0  # σ: with a dozen checks per campaign, no false alarm from noise
-MIN_SAMPLES = 200  # a check on fewer samples is not made
+MIN_SAMPLES = 200  # a check on fewer samples is not made ...
+MIN_CHECK_S = 0.2  # ... or, where a log's rate matters, on less than this much of it (200
+# samples of 1 kHz; a 200 Hz log's one second of free rolling was too few samples to check)
 
 
 class Relation(str, enum.Enum):

@@ -142,8 +142,9 @@ clear of logging noise and of the zero current before braking)."""
 BRAKE_ON_NOISE_FACTOR = 5.0
 BRAKE_ON_CEILING_A = 0.05  # half the valve's dead-band: a command below it does nothing
 NOISY_CURRENT_A = 5e-4  # a logged current noisier than this is denoised ...
-COMMAND_MEDIAN_SAMPLES = 21  # ... by a running median this wide (keeps a command's edges)
-MEDIAN_NOISE_GAIN = 1.2533 / np.sqrt(COMMAND_MEDIAN_SAMPLES)  # its σ on white noise
+COMMAND_MEDIAN_S = 0.021  # ... by a running median this long (keeps a command's edges) ...
+MEDIAN_GAIN = 1.2533  # ... whose σ on white noise is this / √(samples)
+DEFAULT_RATE_HZ = 1000.0
 
 
 def current_noise_a(current_a: np.ndarray) -> float:
@@ -155,30 +156,45 @@ def current_noise_a(current_a: np.ndarray) -> float:
     return float(1.4826 * np.median(np.abs(steps - np.median(steps))) / np.sqrt(2.0))
 
 
-def denoised_command(current_a: np.ndarray) -> tuple[np.ndarray, float]:
+def median_samples(rate_hz: float) -> int:
+    """The running median's width at ``rate_hz``: COMMAND_MEDIAN_S, an odd count of at least
+    3 samples (21 samples at 200 Hz flattened a 6 Hz command and made a null campaign's
+    pressure show a 'line')."""
+    return max(3, 2 * round(COMMAND_MEDIAN_S * rate_hz / 2) + 1)
+
+
+def denoised_command(current_a: np.ndarray, rate_hz: float = DEFAULT_RATE_HZ
+                     ) -> tuple[np.ndarray, float]:
     """The command behind a logged current and the σ of the noise left in it [A].
 
-    A log noisier than 0.5 mA gets a running median of 21 samples: brake commands are held
-    levels, steps and releases, whose edges a median keeps where a low-pass would smear
-    them. A clean log is returned as it is."""
+    A log noisier than 0.5 mA gets a running median of 21 ms (:func:`median_samples` at
+    the log's ``rate_hz``): brake commands are held levels, steps and releases, whose edges
+    a median keeps where a low-pass would smear them. A clean log is returned as it is."""
     current = np.asarray(current_a, dtype=float)
     noise = current_noise_a(current)
     if noise <= NOISY_CURRENT_A:
         return current, noise
-    command = scipy.ndimage.median_filter(current, size=COMMAND_MEDIAN_SAMPLES, mode="nearest")
-    return command, noise * MEDIAN_NOISE_GAIN
+    samples = median_samples(rate_hz)
+    command = scipy.ndimage.median_filter(current, size=samples, mode="nearest")
+    return command, noise * MEDIAN_GAIN / np.sqrt(samples)
 
 
-def brake_start_index(current_a: np.ndarray) -> int | None:
+def brake_start_index(current_a: np.ndarray, rate_hz: float = DEFAULT_RATE_HZ) -> int | None:
     """Index of the first sample whose current commands the brake, or None if none does.
 
     A command is a current above 10 mA, or above 5 σ of the logging noise where the log is
     noisier (on the denoised command, :func:`denoised_command`; capped at 50 mA), so that
     noise alone never starts a braking and noise does not delay the start."""
-    current, noise = denoised_command(current_a)
-    threshold = min(max(BRAKE_ON_CURRENT_A, BRAKE_ON_NOISE_FACTOR * noise), BRAKE_ON_CEILING_A)
-    on = np.flatnonzero(current > threshold)
+    on = np.flatnonzero(commanded(current_a, rate_hz))
     return int(on[0]) if on.size else None
+
+
+def commanded(current_a: np.ndarray, rate_hz: float = DEFAULT_RATE_HZ) -> np.ndarray:
+    """The samples whose current commands the brake (mask (n,)): see
+    :func:`brake_start_index`."""
+    current, noise = denoised_command(current_a, rate_hz)
+    threshold = min(max(BRAKE_ON_CURRENT_A, BRAKE_ON_NOISE_FACTOR * noise), BRAKE_ON_CEILING_A)
+    return current > threshold
 
 
 def logged_to_held(current_logged_a: np.ndarray) -> np.ndarray:

@@ -77,7 +77,18 @@ def plot_spectrum(spectrum: Spectrum, title: str, unit: str, path: Path) -> Path
 def write_diagnosis_report(result: Diagnosis, folder: Path) -> Path:
     """The diagnosis page ``folder/index.html`` with its figures; returns the page."""
     sections = diagnosis_sections(result, folder)
-    return write_html(folder / "index.html", f"Diagnosis: {result.verdict}", sections)
+    return write_html(folder / "index.html", f"Diagnosis: {verdict_text(result)}", sections)
+
+
+def verdict_text(result: Diagnosis) -> str:
+    """The verdict with what names it: a discovered term's family, an unexplained finding's
+    equation."""
+    best = result.findings[0] if result.findings else None
+    if best is not None and best.family and result.verdict == "discovered":
+        return f"{result.verdict} {best.family}"
+    if best is not None and best.equation and result.verdict == "unexplained":
+        return f"{result.verdict}, in the {best.equation}"
+    return result.verdict
 
 
 def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]:
@@ -102,7 +113,7 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
           ", ".join(f"{k} = {v:.4g}" for k, v in f.parameters.items()), _text(f.delta_bic),
           _text(f.held_out), ", ".join(f.fitted_on), ", ".join(f.checked_on)]
          for f in result.candidates])
-    verdict = (f"<p><b>Verdict: {result.verdict}</b>. Starting model: "
+    verdict = (f"<p><b>Verdict: {verdict_text(result)}</b>. Starting model: "
                f"{', '.join(result.start.sources)}. ΔBIC = BIC(with) − BIC(without) on the "
                f"fitting runs (accepted below {BIC_THRESHOLD:g}, and only if the held-out "
                f"runs improve by more than {-HELD_OUT_THRESHOLD:g} in the same "
@@ -205,7 +216,7 @@ def diagnosis_summary(result: Diagnosis) -> str:
     lines = ["candidates:", text_table(["cause", "accepted", "dBIC", "held-out", "held-out fit %"],
                                        rows) if rows else "  (none: the model has them all)"]
     lines.append(f"baseline fit %: {_fits(result.baseline)}")
-    lines.append(f"VERDICT: {result.verdict}")
+    lines.append(f"VERDICT: {verdict_text(result)}")
     if result.verdict == INCONCLUSIVE:
         lines.append("  the runs given cannot test every candidate, or none is left to check one "
                      "on: see the notes")

@@ -13,7 +13,7 @@ differentiates.
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Any
@@ -112,16 +112,23 @@ def resolve(mapping: dict[str, Channel], types: Mapping[str, str], where: str) -
     sources = []
     for contract, (default_topic, default_field) in CONTRACT_SOURCES.items():
         channel = mapping[contract]
-        topic = channel.topic or _find_topic(default_topic, topics, contract, where)
+        topic = channel.topic or _find_topic(default_topic, types, contract, where)
         if topic not in topics:
-            raise RunFormatError(f"{where}: bag has no topic {topic} (for {contract}; topics: "
-                                 f"{', '.join(topics)})")
+            raise RunFormatError(f"{where}: bag has no topic {topic} (for {contract}; it has "
+                                 f"{_listing(types)})")
         field = channel.field or LEGACY_FIELDS.get((contract, types[topic]), default_field)
         sources.append(Source(contract, topic, FieldPath(field), channel))
     return sources
 
 
-def _find_topic(contract_topic: str, topics: Sequence[str], contract: str, where: str) -> str:
+def _listing(types: Mapping[str, str]) -> str:
+    """The bag's topics with their types, for an error a user can act on (issue 30)."""
+    return ", ".join(f"{topic} ({kind})" for topic, kind in sorted(types.items())) or "no topic"
+
+
+def _find_topic(contract_topic: str, types: Mapping[str, str], contract: str, where: str
+                ) -> str:
+    topics = sorted(types)
     if contract_topic in topics:
         return contract_topic
     tail = contract_topic.removeprefix(f"/{NAMESPACE}")
@@ -129,7 +136,8 @@ def _find_topic(contract_topic: str, topics: Sequence[str], contract: str, where
     found = [t for t in topics if any(t.endswith(x) for x in tails)]
     if len(found) == 1:
         return found[0]
-    hint = f"topics {', '.join(found)} all match" if found else "no topic matches"
+    hint = (f"topics {', '.join(found)} all match" if found
+            else f"no topic matches; it has {_listing(types)}")
     raise RunFormatError(f"{where}: bag has no messages on {contract_topic} for {contract} "
                          f"({hint}); name the topic in a column-mapping file "
                          f"({contract}: {{topic: /your/topic}})")

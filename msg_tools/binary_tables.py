@@ -128,11 +128,14 @@ def read_tdms(path: Path) -> Table:
     for channel in channels:
         data = channel[:]
         named += [(channel.name, data), (f"{channel.group_name}/{channel.name}", data)]
-        if "unit_string" in channel.properties:
+        if str(channel.properties.get("unit_string", "")).strip():  # LabVIEW's default: ""
             units[channel.name] = str(channel.properties["unit_string"])
     if channels and "wf_increment" in channels[0].properties:
-        named.append((MASTER_TIME, channels[0].time_track()))
-        units[MASTER_TIME] = "s"
+        try:
+            named.append((MASTER_TIME, channels[0].time_track()))
+            units[MASTER_TIME] = "s"
+        except KeyError:  # wf_increment without wf_start_offset: no waveform time track
+            pass
     return Table(_same_length(named), units)
 
 

@@ -38,7 +38,7 @@ def run_from_table(table: Table, where: str, name: str, mapping: Mapping | None 
                                  f"(found {found}); name it in a column-mapping file")
         fields[CSV_TO_FIELD[contract]] = _to_si(channel, table.columns[channel.column], where)
     check_plausible(fields, where)
-    return Run(name=name, source=where, **fields)
+    return Run(name=name, source=where, notes=table.notes, **fields)
 
 
 def _master_time(channel: Channel, contract: str, table: Table) -> Channel:

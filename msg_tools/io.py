@@ -111,12 +111,13 @@ def read_campaign(folder: Path, mapping: Mapping | None = None,
         if progress and len(sources) > 1:
             progress(f"reading {number}/{len(sources)}: {source.relative_to(folder)}")
         try:
-            split = split_at_gaps(read_run(source, mapping, _campaign_name(folder, source)))
+            run = read_run(source, mapping, _campaign_name(folder, source))
         except RunFormatError as exc:
             problems.append(str(exc))
             continue
+        split = split_at_gaps(run)
         runs.extend(split.parts)
-        problems.extend(split.notes)
+        problems.extend((*run.notes, *split.notes))
     if not runs:
         raise RunFormatError(f"{folder}: no readable run" +
                              (f" ({'; '.join(problems)})" if problems else ""))
@@ -144,9 +145,10 @@ def read_runs(paths: Sequence[Path], mapping: Mapping | None = None) -> Campaign
             runs.extend(campaign.runs)
             problems.extend(campaign.problems)
         else:
-            split = split_at_gaps(read_run(path, mapping))
+            run = read_run(path, mapping)
+            split = split_at_gaps(run)
             runs.extend(split.parts)
-            problems.extend(split.notes)
+            problems.extend((*run.notes, *split.notes))
     names = [r.name for r in runs]
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:

@@ -32,6 +32,9 @@ class Run:
     vertical_load_n: np.ndarray
     longitudinal_force_n: np.ndarray
     source: str = field(default="")
+    notes: tuple[str, ...] = field(default=(), compare=False)
+    """What reading had to do to the file (e.g. a last line cut short, dropped): for the
+    user, beside the run, never silent."""
 
     def __post_init__(self) -> None:
         n = np.shape(self.time_s)

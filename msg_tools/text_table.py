@@ -41,6 +41,7 @@ class Table:
 
     columns: dict[str, np.ndarray]
     units: dict[str, str]
+    notes: tuple[str, ...] = ()
 
 
 def read_text(path: Path) -> str:
@@ -76,24 +77,49 @@ class Dialect:
 
 def read_table(text: str, wanted: Sequence[str], where: str,
                text_columns: Sequence[str] = ()) -> Table:
-    """The ``wanted`` columns of ``text`` (numbers; ``text_columns`` as text)."""
-    lines = text.splitlines()
+    """The ``wanted`` columns of ``text`` (numbers; ``text_columns`` as text). A wanted
+    name may be the whole header cell, unit included (``t [s]``, copied from the file)."""
+    lines, notes = _complete_lines(text, where)
     dialect = sniff(lines, where)
     first, last = data_block(lines, dialect)
-    header_at, names = find_header(lines[:first], dialect, wanted, where)
+    bare = {w: _name(w) for w in wanted}
+    header_at, names = find_header(lines[:first], dialect, list(dict.fromkeys(bare.values())),
+                                   where)
     units = {**_header_units(lines[header_at], dialect, names)}
     for row in lines[header_at + 1:first]:
         cells = split(row, dialect.separator)
         if len(cells) == len(names):
             units.update({n: c.strip() for n, c in zip(names, cells, strict=True) if c.strip()})
     body = lines[first:last]
-    numeric = [n for n in wanted if n not in text_columns]
-    columns = dict(zip(numeric, _numbers(body, dialect, names, numeric, where, first),
-                       strict=True))
+    numeric = [w for w in wanted if w not in text_columns]
+    columns = dict(zip(numeric, _numbers(body, dialect, names, [bare[w] for w in numeric],
+                                         where, first), strict=True))
     for name in wanted:
         if name in text_columns:
-            columns[name] = _text(body, dialect, names.index(name))
-    return Table(columns, units)
+            columns[name] = _text(body, dialect, names.index(bare[name]))
+    units.update({w: units[b] for w, b in bare.items() if w != b and b in units})
+    return Table(columns, units, notes)
+
+
+def _complete_lines(text: str, where: str) -> tuple[list[str], tuple[str, ...]]:
+    """The text's lines without a last one that a logger stopped writing half-way (no
+    final newline, fewer cells than the rows above, numbers up to where it stops), and a
+    note saying so; a file whose last row is whole but lacks the newline is whole."""
+    lines = text.splitlines()
+    if text.endswith(("\n", "\r")) or len(lines) < 3:
+        return lines, ()
+    try:
+        dialect = sniff(lines[:-1], where)
+    except RunFormatError:
+        return lines, ()
+    cells = split(lines[-1], dialect.separator)
+    partial = 0 < len(cells) < dialect.cells and all(
+        _is_number(c, dialect.decimal) for c in cells[:-1])
+    if not partial:
+        return lines, ()
+    rows = sum(_is_data(line, dialect) for line in lines[:-1])
+    return lines[:-1], (f"{where}: last line cut short (the logger stopped mid-write?): "
+                        f"{rows} complete rows read, the partial one dropped",)
 
 
 def split(line: str, separator: str) -> list[str]:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import os
 import subprocess
 import sys
@@ -9,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from landing_gear_sim.cli import main
+from landing_gear_sim.cli import build_parser, main
 from msg_tools.bag_read import read_bag
 from msg_tools.csv_io import read_csv
 
@@ -122,3 +123,53 @@ def test_an_unwritable_output_is_refused_before_the_work(tmp_path, capsys):
     assert len(err.strip().splitlines()) == 1
     assert main(["identify", str(tmp_path), "-o", str(tmp_path)]) == 2  # a folder, not a file
     assert "is a folder" in capsys.readouterr().err
+
+
+def _subcommands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
+    action = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return dict(action.choices)
+
+
+def test_without_never_swallows_the_campaign():
+    """Issue 32: `diagnose --without gear_walk CAMPAIGN` once took the campaign as a second
+    element and failed with 'the following arguments are required: RUN'."""
+    args = build_parser().parse_args(["diagnose", "--without", "gear_walk", "out/c"])
+    assert args.runs == [Path("out/c")] and args.start_without == ["gear_walk"]
+    args = build_parser().parse_args(["diagnose", "out/c", "--without", "drag,gear_walk",
+                                      "--without", "friction_curve"])
+    assert args.start_without == ["drag", "gear_walk", "friction_curve"]
+
+
+def test_an_unknown_element_to_leave_out_is_one_error_line_before_reading(tmp_path, capsys):
+    assert main(["diagnose", "--without", "gear_wlak", str(tmp_path / "none")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "gear_wlak: not a model element" in err[0]
+
+
+def test_every_option_and_argument_says_what_it_is():
+    silent = [f"{name} {action.dest}"
+              for name, sub in _subcommands(build_parser()).items()
+              for action in sub._actions
+              if not isinstance(action, argparse._HelpAction) and not action.help]
+    assert not silent, silent
+
+
+def test_help_loads_no_numerical_library():
+    """`--help` and argument errors answer at once (issue 32: 1.5-24 s under load, most of
+    it scipy): building the parser imports none of the numerical stack."""
+    code = ("import sys; from landing_gear_sim.cli import build_parser; build_parser(); "
+            "print(sorted({m.split('.')[0] for m in sys.modules} & {'numpy', 'scipy', "
+            "'numba', 'matplotlib', 'rosbags', 'rclpy', 'dask'}))")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            check=True)
+    assert result.stdout.strip() == "[]"
+
+
+def test_the_compile_note_is_printed_only_while_compiling(tmp_path, capsys):
+    """Issue 32: "the first run compiles the physics, ~10 s" was printed on every run."""
+    argv = ["simulate", "--profile", "steps", "--duration", "0.5", "--no-plot"]
+    assert main([*argv, "-o", str(tmp_path / "a.csv")]) == 0  # compiles, or loads the cache
+    capsys.readouterr()
+    assert main([*argv, "-o", str(tmp_path / "b.csv")]) == 0
+    err = capsys.readouterr().err
+    assert "simulated in" in err and "compil" not in err

@@ -4,8 +4,10 @@ code under test): the verdict *and* the recovered key parameter."""
 from __future__ import annotations
 
 import dataclasses
+import html
 import json
 import math
+import re
 import signal
 import subprocess
 import sys
@@ -20,6 +22,7 @@ from landing_gear_sim.diagnosis.catalogue import CATALOGUE, gear_walk_key_parame
 from landing_gear_sim.diagnosis.diagnose import diagnose
 from landing_gear_sim.diagnosis.scoring import split_runs
 from landing_gear_sim.errors import DiagnosisError
+from landing_gear_sim.report.diagnosis import parameter_text
 from msg_tools.csv_io import read_csv, write_csv
 from msg_tools.io import read_campaign
 
@@ -201,8 +204,23 @@ def test_cli_writes_the_contract_json_and_the_report(reference, tmp_path, capsys
     assert len(document["consistency_calibrated"]) == len(document["consistency"]) > 0
     page = (tmp_path / "report" / "index.html").read_text()
     assert "calibrated model" in page and "extended model" in page
-    assert "VERDICT: actuator_delay" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "VERDICT: actuator_delay" in out
+    headline = re.search(r"actuator_delay: delay = (\d\.\d+) ± [\d.]+ ms; on runs it was "
+                         r"not fitted on, the extended model is better by \d+", out)
+    assert headline and abs(float(headline[1]) - 6.0) < 0.3, out
+    assert html.escape(headline[0]) in page
     assert main(["params", "--config", str(tmp_path / "extended.yaml")]) == 0
+
+
+@pytest.mark.parametrize(("key", "value", "std", "text"), [
+    ("actuator_delay.delay_s", 0.0059941, 0.00029, "delay = 5.994 ± 0.29 ms"),
+    ("pressure_sensor_offset.offset_pa", -1.2e5, 300.0, "offset = -1.2 ± 0.003 bar"),
+    ("brake_fade.fade_fraction", 0.12, None, "fade_fraction = 12 %"),
+    ("friction.theta1", 0.8123, 0.004, "theta1 = 0.8123 ± 0.004"),
+])
+def test_a_parameter_reads_in_engineering_units(key, value, std, text):
+    assert parameter_text(key, value, std) == text
 
 
 def test_cli_diagnose_on_a_missing_folder_is_one_error_line(capsys):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 import shutil
 
 import numpy as np
@@ -31,7 +32,7 @@ from landing_gear_sim.calibration.runs import (
 )
 from landing_gear_sim.calibration.validate import fit_percent, validate
 from landing_gear_sim.cli import main
-from landing_gear_sim.diagnosis.diagnose import starting_model
+from landing_gear_sim.diagnosis.start import starting_model
 from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import load_parameters
 from landing_gear_sim.model.scenario import constant_pressure_test
@@ -124,6 +125,9 @@ def test_identify_cli_writes_params_and_evidence(campaign_dir, tmp_path, capsys,
     assert "brake_osc_low.png" in page and "friction.png" in page
     assert "actuator_steps_sweep_frf.png" in page  # the actuator's FRF against the model's
     assert (tmp_path / "report" / "actuator_steps_sweep_frf.png").stat().st_size > 10_000
+    assert "fit % = 100·(1 − ‖y − ŷ‖" in page  # issue 32: the fit defined, RMSE, max error
+    errors = page.split("RMSE / max |error| per run and channel")[1]
+    assert "pressure [bar]" in errors and re.search(r"<td>\d[\d.e-]* / \d[\d.e-]*</td>", errors)
     capsys.readouterr()
 
 

@@ -21,7 +21,7 @@ from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
 from msg_tools.bag_io import TYPESTORE, write_bag
 from msg_tools.contract import CSV_COLUMNS, CSV_SCALE_TO_SI, CSV_TO_FIELD
-from msg_tools.csv_io import format_csv
+from msg_tools.csv_io import format_csv, read_mapping
 from msg_tools.errors import RunFormatError
 from msg_tools.io import read_campaign, read_run
 from msg_tools.run import SIGNALS, Run
@@ -112,6 +112,21 @@ def test_units_in_the_file_are_used_time_in_ms_included(tmp_path, run):
                      for k in range(len(run)))
     (tmp_path / "units.csv").write_text(header + "\n" + rows + "\n")
     assert_same_run(read_run(tmp_path / "units.csv"), run)
+
+
+def test_a_mapping_may_copy_header_cells_units_and_all(tmp_path, run):
+    """Issue 30: a mapping naming `t [s]` as the file's header writes it was refused."""
+    cells = {"time_s": "t [ms]", "current_ref_A": "I [A]", "brake_pressure_bar": "p [bar]",
+             "wheel_speed_rad_s": "w [rad/s]", "flywheel_speed_rad_s": "W [rad/s]",
+             "vertical_load_N": "Fz [N]", "longitudinal_force_N": "Fx [N]"}
+    table = contract_table(run)
+    table["time_s"] = table["time_s"] * 1e3
+    rows = "\n".join(",".join(f"{table[c][k]:.15g}" for c in CSV_COLUMNS)
+                     for k in range(len(run)))
+    (tmp_path / "cells.csv").write_text(",".join(cells.values()) + "\n" + rows + "\n")
+    (tmp_path / "map.yaml").write_text("".join(f'{c}: {{column: "{cell}"}}\n'
+                                               for c, cell in cells.items()))
+    assert_same_run(read_run(tmp_path / "cells.csv", read_mapping(tmp_path / "map.yaml")), run)
 
 
 def test_calendar_time_column_is_read_to_the_microsecond(tmp_path, run):
@@ -240,8 +255,10 @@ def test_bag_topics_named_otherwise_need_and_take_a_mapping(tmp_path, run):
     write_bag(run, tmp_path / "bag")
     rewrite_bag(tmp_path / "bag", tmp_path / "other",
                 lambda t: "/hyd/p1" if t.endswith("pressure") else t)
-    with pytest.raises(RunFormatError, match=re.escape("brake_pressure_bar: {topic: /your/topic}")):
+    with pytest.raises(RunFormatError, match=re.escape("brake_pressure_bar: {topic: /your/topic}")
+                       ) as refused:
         read_run(tmp_path / "other")
+    assert "/hyd/p1 (sensor_msgs/msg/FluidPressure)" in str(refused.value)  # what it has
     (tmp_path / "map.yaml").write_text("brake_pressure_bar: {topic: /hyd/p1}\n")
     assert main(["convert", str(tmp_path / "other"), str(tmp_path / "back.csv"),
                  "--mapping", str(tmp_path / "map.yaml")]) == 0
@@ -334,3 +351,42 @@ def test_implausible_files_are_refused_with_one_line_and_exit_2(tmp_path, run, c
     assert fragment in error and "Traceback" not in error
     assert len(error.strip().splitlines()) == 1
     assert not (tmp_path / "out.csv").exists()
+
+
+@pytest.mark.parametrize("cut_at", [0.6, 0.95])
+def test_a_csv_cut_mid_row_keeps_every_complete_row_and_says_what_was_lost(tmp_path, run,
+                                                                            capsys, cut_at):
+    """Issue 30: a logger killed mid-write left half a last line, and the whole file was
+    refused ("no table of numbers found")."""
+    whole = text(run)
+    cut = whole[:round(cut_at * len(whole))]
+    cut = cut[:-3] if cut.endswith("\n") else cut  # mid-row, whatever the rounding
+    (tmp_path / "camp").mkdir()
+    (tmp_path / "camp" / "cut.csv").write_text(cut)
+    complete = cut.count("\n") - 1  # rows ended by a newline, the header aside
+    campaign = read_campaign(tmp_path / "camp")
+    assert len(campaign.runs[0]) == complete
+    assert np.allclose(campaign.runs[0].time_s, run.time_s[:complete], rtol=0, atol=1e-9)
+    assert any("last line cut short" in p and f"{complete} complete rows" in p
+               for p in campaign.problems), campaign.problems
+    assert main(["convert", str(tmp_path / "camp" / "cut.csv"), str(tmp_path / "back.csv")]) == 0
+    assert "last line cut short" in capsys.readouterr().err
+    assert len(read_run(tmp_path / "back.csv")) == complete
+
+
+def test_a_csv_without_a_final_newline_is_whole(tmp_path, run):
+    (tmp_path / "whole.csv").write_text(text(run).rstrip("\n"))
+    read = read_run(tmp_path / "whole.csv")
+    assert len(read) == len(run) and not read.notes
+
+
+def test_tdms_with_labviews_empty_units_and_half_time_properties_reads(tmp_path, run):
+    """Issue 30: LabVIEW's default empty unit was refused as an unknown unit, and a channel
+    with wf_increment but no wf_start_offset (npTDMS's Digital_Input.tdms) raised a
+    KeyError through identify."""
+    nptdms = pytest.importorskip("nptdms")
+    properties = {"unit_string": "", "wf_increment": 1e-3}
+    with nptdms.TdmsWriter(tmp_path / "labview.tdms") as writer:
+        writer.write_segment([nptdms.ChannelObject("rig", name, values, properties=properties)
+                              for name, values in columns(run).items()])
+    assert_same_run(read_run(tmp_path / "labview.tdms"), run)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import shutil
 
@@ -170,3 +171,15 @@ def test_compare_cli_scores_a_simulation_against_itself(tmp_path, csv_file, caps
                  str(tmp_path / "c.png")]) == 0
     out = capsys.readouterr().out
     assert "wheel_speed_rad_s" in out and "100.00" in out
+
+
+def test_compare_prints_errors_in_the_units_of_its_plot(tmp_path, csv_file, capsys):
+    """Issue 32: RMSE in Pa and N on the terminal, bar and kN on the plot."""
+    shifted = tmp_path / "shifted.csv"
+    run = read_csv(csv_file)
+    write_csv(dataclasses.replace(run, pressure_pa=run.pressure_pa + 0.5e5), shifted)
+    assert main(["compare", str(shifted), str(csv_file), "--plot",
+                 str(tmp_path / "c.png")]) == 0
+    pressure = next(line for line in capsys.readouterr().out.splitlines()
+                    if line.lstrip().startswith("pressure_pa"))
+    assert "0.5 bar" in pressure and "kN" not in pressure

@@ -14,6 +14,7 @@ from landing_gear_sim.cli.common import (
     mapping_of,
     params_of,
     progress,
+    read_one,
     write_atomically,
 )
 from landing_gear_sim.errors import IdentificationError, LandingGearSimError
@@ -31,7 +32,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     ident = sub.add_parser("identify", help="calibrate the model on a campaign folder")
     ident.add_argument("campaign", type=Path, help="folder of runs (CSV files, bags)")
     add_params_arguments(ident)
-    ident.add_argument("-o", "--output", type=Path, default=Path("out/calibrated.yaml"))
+    ident.add_argument("-o", "--output", type=Path, default=Path("out/calibrated.yaml"),
+                       help="calibrated params file (default out/calibrated.yaml)")
     ident.add_argument("--fix-theta3", action="store_true", help="keep Burckhardt theta3")
     ident.add_argument("--mapping", type=Path, help="column-mapping file for the CSVs")
     ident.add_argument("--partial", action="store_true",
@@ -40,16 +42,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     ident.set_defaults(func=cmd_identify)
 
     val = sub.add_parser("validate", help="simulate a campaign with its inputs; fit report")
-    val.add_argument("campaign", type=Path)
+    val.add_argument("campaign", type=Path, help="folder of runs (CSV files, bags)")
     add_params_arguments(val)
-    val.add_argument("--report", type=Path, default=Path("out/validation"))
+    val.add_argument("--report", type=Path, default=Path("out/validation"),
+                     help="folder of the HTML fit report (default out/validation)")
     val.add_argument("--mapping", type=Path, help="column-mapping file for the CSVs")
     val.set_defaults(func=cmd_validate)
 
     cmp_ = sub.add_parser("compare", help="fit per channel of a simulated vs a measured run")
-    cmp_.add_argument("measured", type=Path)
-    cmp_.add_argument("simulated", type=Path)
-    cmp_.add_argument("--plot", type=Path, default=Path("out/compare.png"))
+    cmp_.add_argument("measured", type=Path, help="the rig's run (CSV or bag)")
+    cmp_.add_argument("simulated", type=Path, help="the model's run of the same input")
+    cmp_.add_argument("--plot", type=Path, default=Path("out/compare.png"),
+                      help="PNG path (default out/compare.png)")
     cmp_.add_argument("--mapping", type=Path, help="column-mapping file for MEASURED")
     cmp_.set_defaults(func=cmd_compare)
 
@@ -57,10 +61,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     diag.add_argument("runs", type=Path, nargs="+", metavar="RUN",
                       help="CSV files, bags, or campaign folders")
     add_params_arguments(diag, without=False)
-    diag.add_argument("--without", action="extend", nargs="+", default=[], metavar="ELEMENT",
-                      dest="start_without",
-                      help="start from a model without these elements, e.g. gear_walk, "
-                      "friction_curve (the diagnosis must then rediscover them)")
+    diag.add_argument("--without", action="extend", type=_names, default=[],
+                      metavar="ELEMENT[,ELEMENT...]", dest="start_without",
+                      help="start from a model without these elements (one value: repeat the "
+                      "option or separate with commas), e.g. gear_walk, friction_curve: the "
+                      "diagnosis must then rediscover them")
     diag.add_argument("--json", type=Path, help="write the diagnosis contract JSON here")
     diag.add_argument("--report", type=Path, help="write the HTML report into this folder")
     diag.add_argument("-o", "--output", type=Path, help="write the extended model (params)")
@@ -77,7 +82,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     anti = sub.add_parser("antiskid", help="an anti-skid controller against the rig model, "
                           "offline; metrics against a constant-pressure stop")
-    anti.add_argument("--controller", choices=["threshold", "slip"], default="threshold")
+    anti.add_argument("--controller", choices=["threshold", "slip"], default="threshold",
+                      help="anti-skid logic (default threshold)")
     anti.add_argument("--surface", choices=["dry", "wet", "snow"], default="dry",
                       help="runway friction curve (dry: the rig's own)")
     add_params_arguments(anti)
@@ -159,28 +165,40 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 def cmd_compare(args: argparse.Namespace) -> int:
     from landing_gear_sim.calibration.validate import compare
+    from landing_gear_sim.report.figures import DISPLAY_UNITS
     from landing_gear_sim.report.pages import text_table
     from landing_gear_sim.report.validation import plot_overlay
-    from msg_tools.io import read_run
 
     check_outputs(files=[args.plot])
-    measured, simulated = read_run(args.measured, mapping_of(args)), read_run(args.simulated)
+    measured, simulated = read_one(args.measured, mapping_of(args)), read_one(args.simulated)
     comparison = compare(measured, simulated)
-    rows = [[channel, f"{s.fit_percent:.2f}", f"{s.rmse:.4g}", f"{s.max_error:.4g}"]
-            for channel, s in comparison.scores.items()]
-    print(text_table(["channel (SI)", "fit %", "RMSE", "max |error|"], rows))
+    rows = []
+    for channel, score in comparison.scores.items():
+        factor, unit = DISPLAY_UNITS[channel]  # as the plot shows it (issue 32: Pa and N)
+        rows.append([channel, f"{score.fit_percent:.2f}", f"{score.rmse * factor:.4g} {unit}",
+                     f"{score.max_error * factor:.4g} {unit}"])
+    print(text_table(["channel", "fit %", "RMSE", "max |error|"], rows))
     print(f"plot: {plot_overlay(comparison, args.plot)}")
     return 0
+
+
+def _names(text: str) -> list[str]:
+    """One ``--without`` value: a name or a comma-separated list (a value per option, so
+    that the option never takes the campaign after it for an element)."""
+    return [name.strip() for name in text.split(",") if name.strip()]
 
 
 def cmd_diagnose(args: argparse.Namespace) -> int:
     import json
 
+    from landing_gear_sim.diagnosis.start import starting_model
+
+    check_outputs(files=[args.json, args.output], folders=[args.report])
+    starting_model(params_of(args), args.start_without)  # a misspelt element: at once
+
     from landing_gear_sim.diagnosis.diagnose import diagnose
     from landing_gear_sim.report.diagnosis import diagnosis_summary, write_diagnosis_report
     from msg_tools.io import read_runs
-
-    check_outputs(files=[args.json, args.output], folders=[args.report])
 
     campaign = read_runs(args.runs, mapping_of(args))
     for problem in campaign.problems:
@@ -208,11 +226,10 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
 def cmd_metrics(args: argparse.Namespace) -> int:
     from antiskid.metrics import braking_metrics
     from landing_gear_sim.report.braking import metrics_table
-    from msg_tools.io import read_run
 
     check_outputs(files=[args.json, args.plot])
     rig = params_of(args)
-    run = read_run(args.run, mapping_of(args))
+    run = read_one(args.run, mapping_of(args))
     metrics = braking_metrics(run, rig)
     print(metrics_table({run.name: metrics}))
     _write_braking_outputs(args, run, rig, metrics)

@@ -6,8 +6,11 @@ import argparse
 import math
 import sys
 import tempfile
-from collections.abc import Callable, Sequence
+import threading
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from landing_gear_sim.errors import LandingGearSimError
 from landing_gear_sim.model.parameters import (
@@ -17,8 +20,11 @@ from landing_gear_sim.model.parameters import (
     parse_assignment,
 )
 from landing_gear_sim.model.runspec import PROFILES, RunSpec
-from msg_tools.csv_io import Mapping
 from msg_tools.units import PA_PER_BAR
+
+if TYPE_CHECKING:
+    from msg_tools.csv_io import Mapping
+    from msg_tools.run import Run
 
 PROG = "landing-gear-sim"
 
@@ -26,6 +32,28 @@ PROG = "landing-gear-sim"
 def progress(message: str) -> None:
     """One progress line on stderr (stdout carries the results)."""
     print(f"[{PROG}] {message}", file=sys.stderr, flush=True)
+
+
+COMPILE_NOTE_AFTER_S = 1.0  # loading the compiled physics from numba's cache takes ~0.3 s
+
+
+@contextmanager
+def note_if_compiling() -> Iterator[None]:
+    """Say so when the work inside is compiling the physics (once after an install or a
+    change, ~10 s) rather than print that note on every run."""
+    from landing_gear_sim.model.integrate import compiled
+
+    def note() -> None:
+        if not compiled():
+            progress("compiling the physics for this machine (once after an install, ~10 s)")
+
+    timer = threading.Timer(COMPILE_NOTE_AFTER_S, note)
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
 
 
 def add_params_arguments(parser: argparse.ArgumentParser, without: bool = True) -> None:
@@ -37,6 +65,11 @@ def add_params_arguments(parser: argparse.ArgumentParser, without: bool = True) 
         parser.add_argument("--without", action="append", default=[], choices=ELEMENTS,
                             metavar="ELEMENT",
                             help=f"switch an element off ({', '.join(ELEMENTS)})")
+
+
+def add_storage_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap",
+                        help="bag storage format (default mcap)")
 
 
 def add_run_arguments(parser: argparse.ArgumentParser) -> None:
@@ -69,6 +102,16 @@ def run_spec_of(args: argparse.Namespace) -> RunSpec:
                    current_a=math.nan if args.current_a is None else args.current_a,
                    file=str(args.file or ""), contact=contact,
                    duration_s=args.duration or 0.0, rate_hz=args.rate or 0.0)
+
+
+def read_one(path: Path, mapping: Mapping | None = None) -> Run:
+    """The run of ``path``, saying what reading had to do to it (a cut last line)."""
+    from msg_tools.io import read_run
+
+    run = read_run(path, mapping)
+    for note in run.notes:
+        progress(f"note: {note}")
+    return run
 
 
 def mapping_of(args: argparse.Namespace) -> Mapping | None:

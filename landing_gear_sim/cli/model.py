@@ -8,16 +8,17 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from landing_gear_sim.cli.common import (
     PROG,
     add_params_arguments,
     add_run_arguments,
+    add_storage_argument,
     check_outputs,
     mapping_of,
+    note_if_compiling,
     params_of,
     progress,
+    read_one,
     run_spec_of,
 )
 from landing_gear_sim.errors import LandingGearSimError
@@ -37,9 +38,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     sim.add_argument("--noise-seed", type=int, help="seed of the sensor noise (sensors.*)")
     sim.add_argument("-o", "--output", type=Path, help="CSV path (default out/<name>.csv)")
     sim.add_argument("--bag", type=Path, help="also write a rosbag2 folder here")
-    sim.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
+    add_storage_argument(sim)
     sim.add_argument("--plot", type=Path, help="PNG path (default next to the CSV)")
-    sim.add_argument("--no-plot", action="store_true")
+    sim.add_argument("--no-plot", action="store_true", help="write no PNG")
     sim.set_defaults(func=cmd_simulate)
 
     rig = sub.add_parser("rig", help="bring the ROS 2 node graph up for one run; record a bag")
@@ -55,7 +56,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                      help="lockstep: sim time, deterministic (default); realtime: wall clock")
     rig.add_argument("--bag", type=Path, help="bag folder (default out/rig/<run>_<time>)")
     rig.add_argument("--no-bag", action="store_true", help="run without the recorder")
-    rig.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
+    add_storage_argument(rig)
     rig.add_argument("--noise", action="store_true", help="add the sensors.* noise")
     rig.add_argument("--timeout", type=float, default=10.0,
                      help="lockstep: seconds to wait for a silent node before holding its input")
@@ -75,9 +76,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     bode.add_argument("--speeds", type=float, nargs="+", default=[10.0, 30.0, 60.0],
                       help="operating speeds [m/s]")
     bode.add_argument("--slip", type=float, default=0.05, help="operating slip (default 0.05)")
-    bode.add_argument("--fmin", type=float, default=0.1)
-    bode.add_argument("--fmax", type=float, default=100.0)
-    bode.add_argument("-o", "--output", type=Path, default=Path("out/bode.png"))
+    bode.add_argument("--fmin", type=float, default=0.1, help="lowest frequency [Hz] (0.1)")
+    bode.add_argument("--fmax", type=float, default=100.0,
+                      help="highest frequency [Hz] (100)")
+    bode.add_argument("-o", "--output", type=Path, default=Path("out/bode.png"),
+                      help="PNG path (default out/bode.png)")
     bode.set_defaults(func=cmd_bode)
 
     show = sub.add_parser("params", help="show (or write) the effective parameter set")
@@ -88,7 +91,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     gen = sub.add_parser("campaign", help="generate a synthetic rig campaign (own generator)")
     gen.add_argument("output", type=Path, help="new folder for the runs")
     add_params_arguments(gen)
-    gen.add_argument("--seed", type=int, default=1)
+    gen.add_argument("--seed", type=int, default=1,
+                     help="the rig's deviations and the noise; the same seed, the same campaign")
     gen.add_argument("--deviation", type=float, default=0.03,
                      help="largest relative deviation of the rig from the datasheet")
     gen.add_argument("--logger", default="", metavar="KEY=VALUE,...",
@@ -102,9 +106,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     gen.set_defaults(func=cmd_campaign)
 
     conv = sub.add_parser("convert", help="convert a run between CSV and rosbag2")
-    conv.add_argument("input", type=Path)
+    conv.add_argument("input", type=Path, help="a run: CSV, bag folder or another format")
     conv.add_argument("output", type=Path, help="*.csv, or a bag folder")
-    conv.add_argument("--storage", choices=["mcap", "sqlite3"], default="mcap")
+    add_storage_argument(conv)
     conv.add_argument("--mapping", type=Path, help="column-mapping file for a CSV input")
     conv.set_defaults(func=cmd_convert)
 
@@ -123,6 +127,8 @@ def _summary(result: SimulationResult) -> str:
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from landing_gear_sim.model.integrate import simulate
     from landing_gear_sim.report.figures import plot_simulation
     from landing_gear_sim.ros.graph import load_scenario
@@ -137,9 +143,10 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         raise LandingGearSimError("--profile file needs --file RUN")
     scenario = load_scenario(run_spec_of(args), params)
     progress(f"simulating {scenario.name} (up to {scenario.duration_s:.1f} s at "
-              f"{scenario.rate_hz:g} Hz; the first run compiles the physics, ~10 s)")
+              f"{scenario.rate_hz:g} Hz)")
     started = time.perf_counter()
-    result = simulate(params, scenario)
+    with note_if_compiling():
+        result = simulate(params, scenario)
     progress(f"simulated in {time.perf_counter() - started:.2f} s")
     output = args.output or Path("out") / f"{scenario.name}.csv"
     output.parent.mkdir(parents=True, exist_ok=True)
@@ -184,8 +191,10 @@ def cmd_rig(args: argparse.Namespace) -> int:
                            replay=args.replay is not None, controller=args.controller,
                            parameter_services=args.parameter_services,
                            namespace=args.namespace.strip("/"))
-    progress(f"{scenario.name}: {args.clock} graph, up to {scenario.duration_s:.1f} s at "
-              f"{scenario.rate_hz:g} Hz")
+    source = {None: scenario.name, "external": "your controller"}.get(
+        args.controller, f"the {args.controller} controller")  # not "external: ..." (issue 32)
+    progress(f"{source} in the {args.clock} graph, up to {scenario.duration_s:.1f} s at "
+             f"{scenario.rate_hz:g} Hz")
     started = time.perf_counter()
     outcome = run_graph(options, params, progress)
     wall = time.perf_counter() - started
@@ -222,6 +231,8 @@ def _bag_summary(bag: Path) -> str:
 
 
 def cmd_bode(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from landing_gear_sim.model.linear import frequency_response, resonance_hz
     from landing_gear_sim.report.figures import plot_bode
 
@@ -253,6 +264,8 @@ def cmd_params(args: argparse.Namespace) -> int:
 
 
 def cmd_campaign(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from landing_gear_sim.calibration.campaign import GENERATING_FILE, generate_campaign, rig_like
     from landing_gear_sim.calibration.logger import Logger
 
@@ -273,9 +286,8 @@ def cmd_campaign(args: argparse.Namespace) -> int:
 def cmd_convert(args: argparse.Namespace) -> int:
     from msg_tools.bag_io import write_bag
     from msg_tools.csv_io import write_csv
-    from msg_tools.io import read_run
 
-    run = read_run(args.input, mapping_of(args))
+    run = read_one(args.input, mapping_of(args))
     if args.output.exists():
         raise LandingGearSimError(f"{args.output}: exists already, not overwriting")
     if args.output.suffix == ".csv":

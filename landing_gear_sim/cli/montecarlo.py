@@ -24,7 +24,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     """Add ``montecarlo`` to the ``landing-gear-sim`` parser."""
     mc = sub.add_parser("montecarlo", help="closed-loop stops over surfaces, speeds, loads and "
                         "identified parameters (Dask): distributions, worst cases to replay")
-    mc.add_argument("--controller", choices=["threshold", "slip"], required=True)
+    mc.add_argument("--controller", choices=["threshold", "slip"], required=True,
+                    help="anti-skid logic to test")
     add_params_arguments(mc, without=False)
     mc.add_argument("--cases", type=int, default=200, help="stops to simulate (default 200)")
     mc.add_argument("--seed", type=int, default=1, help="the same seed gives the same cases")

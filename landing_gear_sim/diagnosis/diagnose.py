@@ -55,15 +55,14 @@ from landing_gear_sim.diagnosis.signatures import (
     unexplained,
     window_regressors,
 )
+from landing_gear_sim.diagnosis.start import FRICTION_CURVE, starting_model
 from landing_gear_sim.errors import DiagnosisError, IdentificationError
-from landing_gear_sim.model.parameters import ELEMENTS, RigParameters
+from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.processes import pool_worker, single_threaded_blas
 from msg_tools.run import Run
 
 MAX_ROUNDS = 4
 INCONCLUSIVE = "inconclusive"  # the verdict when the campaign cannot test every candidate
-FRICTION_CURVE = "friction_curve"
-REMOVABLE = (*ELEMENTS, FRICTION_CURVE)
 
 
 @dataclass
@@ -104,15 +103,6 @@ class Diagnosis:
                 "local_gains": {"calibrated": [g.to_json() for g in self.local_before],
                                 "extended": [g.to_json() for g in self.local_after]},
                 "problems": self.problems}
-
-
-def starting_model(base: RigParameters, without: Sequence[str]) -> RigParameters:
-    """``base`` with the elements of ``without`` removed (friction_curve: not calibrated)."""
-    unknown = [w for w in without if w not in REMOVABLE]
-    if unknown:
-        raise DiagnosisError(f"--without {unknown[0]}: not a model element; choose from "
-                             f"{', '.join(REMOVABLE)}")
-    return base.without(*(w for w in without if w != FRICTION_CURVE))
 
 
 def candidates_for(start: RigParameters, without: Sequence[str]) -> list[Candidate]:

@@ -191,8 +191,9 @@ def _evidence(candidate: Candidate, delta_bic: float, held: float | None,
         words.append("no run left to check it on")
     else:
         gains = ", ".join(f"{c} {before[c]:.1f} → {after[c]:.1f} %" for c in after)
+        change = f"better by {-held:.0f}" if held < 0 else f"worse by {held:.0f}"
         words.append(f"on {len(held_runs)} held-out runs: {gains} "
-                     f"(log-likelihood change {held:+.0f})")
+                     f"(log-likelihood {change})")
     related = [s.describe() for s in signatures
                if s.channel in candidate.channels and not s.tentative]
     if related:

@@ -145,6 +145,12 @@ class SimulationResult:
 BATCH_CHUNK = 16  # sets simulated at once: bounds the output buffer of a large batch
 
 
+def compiled() -> bool:
+    """The run loop is compiled in this process (or loaded from numba's cache): what a
+    first run after an install or a change spends ~10 s on has been done."""
+    return bool(run_kernel.signatures)
+
+
 def simulate(params: RigParameters, scenario: Scenario) -> SimulationResult:
     """Simulate one scenario with one parameter set."""
     vector = params.vector()

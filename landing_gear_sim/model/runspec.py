@@ -12,12 +12,16 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from types import ModuleType
+from typing import TYPE_CHECKING
 
 from landing_gear_sim.errors import ScenarioError
-from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.parameters import RigParameters
-from msg_tools.run import Run
 from msg_tools.units import PA_PER_BAR
+
+if TYPE_CHECKING:
+    from landing_gear_sim.model import scenario as sc
+    from msg_tools.run import Run
 
 CONTACT_CHOICES = ("auto", "rig", "actuator")
 """``auto``: the profile's own test (braking profiles on the flywheel, actuator
@@ -74,10 +78,19 @@ class RunSpec:
         return self.profile.replace("-", "_")
 
 
-Builder = Callable[[RunSpec, RigParameters], sc.Profile]
+Builder = Callable[[RunSpec, RigParameters], "sc.Profile"]
+
+
+def _sc() -> ModuleType:
+    """The scenario module, read when a run is built: the CLI's parser reads this one for
+    the profile names, and the numerical stack costs it a second (issue 32)."""
+    from landing_gear_sim.model import scenario
+
+    return scenario
 
 
 def _constant(spec: RunSpec, params: RigParameters) -> sc.Profile:
+    sc = _sc()
     if not math.isnan(spec.current_a):
         return sc.constant(spec.current_a)
     return sc.constant(sc.current_for_pressure(params, spec.pressure_pa))
@@ -86,12 +99,13 @@ def _constant(spec: RunSpec, params: RigParameters) -> sc.Profile:
 # profile name -> (builder, wheel on the flywheel?, actuator-test duration [s])
 PROFILES: dict[str, tuple[Builder, bool, float]] = {
     "constant": (_constant, True, 0.0),
-    "osc-low": (lambda s, p: sc.oscillating(**sc.OSC_LOW), True, 0.0),
-    "osc-high": (lambda s, p: sc.oscillating(**sc.OSC_HIGH), True, 0.0),
-    "ramp": (lambda s, p: sc.quasi_static_ramp(p.number("actuator.max_current_a")), False, 20.0),
-    "steps": (lambda s, p: sc.steps(), False, 8.0),
-    "sweep": (lambda s, p: sc.sine_sweep(), False, 20.0),
-    "steps-sweep": (lambda s, p: sc.steps_then_sweep(), False, 28.0),
+    "osc-low": (lambda s, p: _sc().oscillating(**_sc().OSC_LOW), True, 0.0),
+    "osc-high": (lambda s, p: _sc().oscillating(**_sc().OSC_HIGH), True, 0.0),
+    "ramp": (lambda s, p: _sc().quasi_static_ramp(p.number("actuator.max_current_a")),
+             False, 20.0),
+    "steps": (lambda s, p: _sc().steps(), False, 8.0),
+    "sweep": (lambda s, p: _sc().sine_sweep(), False, 20.0),
+    "steps-sweep": (lambda s, p: _sc().steps_then_sweep(), False, 28.0),
 }
 
 
@@ -104,6 +118,7 @@ def build_scenario(spec: RunSpec, params: RigParameters, recorded: Run | None = 
         ScenarioError: the profile cannot be built (e.g. a pressure outside the valve range,
             a ``file`` profile without its recorded run).
     """
+    sc = _sc()
     rate = spec.rate_hz or None
     if spec.profile == "external":
         return sc.rig_test(params, sc.constant(0.0), "external", rate)

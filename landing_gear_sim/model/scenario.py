@@ -13,8 +13,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.ndimage
-import scipy.signal
 
 from landing_gear_sim.errors import ScenarioError
 from landing_gear_sim.model.parameters import RigParameters
@@ -110,6 +108,8 @@ def sine_sweep(f0_hz: float = 0.5, f1_hz: float = 100.0, duration_s: float = 20.
                mean_a: float = 0.5, amplitude_a: float = 0.15) -> Profile:
     """Logarithmic sine sweep f0 → f1 around ``mean_a`` (paper Fig. 9 right)."""
     def profile(t: np.ndarray) -> np.ndarray:
+        import scipy.signal  # here: the CLI's parser reads this module, and scipy costs ~1 s
+
         tt = np.clip(t, 0.0, duration_s)
         wave = scipy.signal.chirp(tt, f0_hz, duration_s, f1_hz, method="logarithmic", phi=-90)
         return mean_a + amplitude_a * wave
@@ -175,6 +175,8 @@ def denoised_command(current_a: np.ndarray, rate_hz: float = DEFAULT_RATE_HZ
     if noise <= NOISY_CURRENT_A:
         return current, noise
     samples = median_samples(rate_hz)
+    import scipy.ndimage  # here, as scipy.signal above
+
     command = scipy.ndimage.median_filter(current, size=samples, mode="nearest")
     return command, noise * MEDIAN_GAIN / np.sqrt(samples)
 

@@ -4,9 +4,14 @@ spectrum of the starting model; and the summary printed on the terminal."""
 
 from __future__ import annotations
 
+import html
+import textwrap
 from collections.abc import Sequence
 from pathlib import Path
 
+import matplotlib.artist
+import matplotlib.lines
+import matplotlib.patches
 import matplotlib.pyplot as plt
 import matplotlib.ticker
 import numpy as np
@@ -20,6 +25,7 @@ from landing_gear_sim.report.figures import DISPLAY_UNITS, save_figure
 from landing_gear_sim.report.local import local_gain_section
 from landing_gear_sim.report.pages import html_image, html_table, text_table, write_html
 from msg_tools.run import Run
+from msg_tools.units import display
 
 
 def plot_before_after(measured: Run, before: Run, after: Run, channels: Sequence[str],
@@ -91,6 +97,56 @@ def verdict_text(result: Diagnosis) -> str:
     return result.verdict
 
 
+KEY_UNITS = {"s": "s", "pa": "Pa", "n": "N", "a": "A", "m": "m", "j": "J", "hz": "Hz",
+             "fraction": "1"}
+"""A parameter key's last word -> its SI unit (a key carries its unit, docs/parameters.md)."""
+
+
+def parameter_text(key: str, value: float, std: float | None) -> str:
+    """``name = value ± σ`` in the unit a brake engineer reads, e.g. 'delay = 5.99 ± 0.29 ms'
+    for ``actuator_delay.delay_s`` (issue 32: 0.0059941 ± 0.00029 s)."""
+    name, _, suffix = key.rsplit(".", 1)[-1].rpartition("_")
+    unit = KEY_UNITS.get(suffix)
+    if unit is None or unit == "1":
+        name = key.rsplit(".", 1)[-1]
+    if unit is None:
+        return f"{name} = {value:.4g}" + ("" if std is None else f" ± {std:.2g}")
+    shown = display(value, unit, ".4g")
+    if std is None:
+        return f"{name} = {shown}"
+    number, _, unit_shown = shown.partition(" ")
+    return f"{name} = {number} ± {display(std, unit, '.2g').partition(' ')[0]} {unit_shown}"
+
+
+def headline(result: Diagnosis) -> str:
+    """The verdict in one sentence: the cause, its parameters in engineering units, and what
+    it gains on the runs it was not fitted on, stated as an improvement."""
+    if not result.findings:
+        return {"none": "The calibrated model explains every run: nothing is missing.",
+                INCONCLUSIVE: "Inconclusive: the runs cannot test every candidate (see the "
+                "notes)."}.get(result.verdict, f"{result.verdict}.")
+    best = result.findings[0]
+    values = ", ".join(parameter_text(k, v, best.std.get(k)) for k, v in best.parameters.items())
+    sentence = f"{verdict_text(result)}: {values}" if values else verdict_text(result)
+    if best.held_out is not None and best.held_out < 0:
+        gain = ", ".join(f"{c.split('_')[0]} {best.fit_before[c]:.1f} → {best.fit_after[c]:.1f} %"
+                         for c in best.fit_after if c in best.fit_before)
+        sentence += (f"; on runs it was not fitted on, the extended model is better by "
+                     f"{-best.held_out:.0f} log-likelihood units" + (f" ({gain})" if gain else ""))
+    return sentence + "."
+
+
+def _structure_table(result: Diagnosis) -> str:
+    """What the residuals still hold, before and after; saying so when nothing is left."""
+    after = [s.describe() for s in result.signatures_after] or [
+        "no structure left: no line, lag or correlation in its residuals stands above "
+        "their noise"]
+    return html_table(["model", "signature"],
+                      [["calibrated starting model", s.describe()]
+                       for s in result.signatures_before]
+                      + [["extended model", text] for text in after])
+
+
 def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]:
     """HTML sections of the diagnosis page; figures are written into ``folder``. Draws the
     simulations and spectra the diagnosis kept (``result.evidence``), computes nothing."""
@@ -98,22 +154,21 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
         return ", ".join(f"{c}: {v:.2f} %" for c, v in values.items())
 
     findings = html_table(
-        ["cause", "parameters (SI) ± 1σ", "ΔBIC", "held-out Δ", "held-out fit before",
+        ["cause", "parameters ± 1σ", "ΔBIC", "held-out improvement", "held-out fit before",
          "after", "evidence"],
         [[f.cause + (f" ({f.family}): {f.term}" if f.term else "")
           + (f" — in the {f.equation} ({f.channel})" if f.equation else ""),
-          ", ".join(f"{k} = {v:.5g}" + (f" ± {f.std[k]:.2g}" if k in f.std else "")
-                    for k, v in f.parameters.items()),
-          _text(f.delta_bic), _text(f.held_out), fits(f.fit_before), fits(f.fit_after),
+          ", ".join(parameter_text(k, v, f.std.get(k)) for k, v in f.parameters.items()),
+          _text(f.delta_bic), _improvement(f.held_out), fits(f.fit_before), fits(f.fit_after),
           f.evidence] for f in result.findings])
     candidates = html_table(
-        ["cause", "accepted", "key parameters", "ΔBIC", "held-out Δ", "fitted on",
+        ["cause", "accepted", "key parameters", "ΔBIC", "held-out improvement", "fitted on",
          "checked on"],
         [[f.cause, "yes" if f.accepted else "no",
           ", ".join(f"{k} = {v:.4g}" for k, v in f.parameters.items()), _text(f.delta_bic),
-          _text(f.held_out), ", ".join(f.fitted_on), ", ".join(f.checked_on)]
+          _improvement(f.held_out), ", ".join(f.fitted_on), ", ".join(f.checked_on)]
          for f in result.candidates])
-    verdict = (f"<p><b>Verdict: {verdict_text(result)}</b>. Starting model: "
+    verdict = (f"<p><b>{html.escape(headline(result))}</b></p><p>Starting model: "
                f"{', '.join(result.start.sources)}. ΔBIC = BIC(with) − BIC(without) on the "
                f"fitting runs (accepted below {BIC_THRESHOLD:g}, and only if the held-out "
                f"runs improve by more than {-HELD_OUT_THRESHOLD:g} in the same "
@@ -121,10 +176,10 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
     sections = [("Verdict", verdict + findings), ("Candidates", candidates),
                 ("Starting model, calibrated: fit %", html_table(
                     ["channel", "fit %"], [[c, f"{v:.2f}"] for c, v in result.baseline.items()])),
-                ("Residual structure", html_table(
-                    ["model", "signature"],
-                    [["calibrated starting model", s.describe()] for s in result.signatures_before]
-                    + [["extended model", s.describe()] for s in result.signatures_after]))]
+                ("Residual structure", _structure_table(result))]
+    if result.problems:
+        sections.insert(1, ("Notes", html_table(["what the diagnosis could not do"],
+                                                [[p] for p in result.problems])))
     if result.consistency:
         sections.append(_consistency_section(result.consistency_calibrated,
                                              result.consistency, folder))
@@ -153,8 +208,15 @@ def _consistency_section(calibrated: Sequence[Check], extended: Sequence[Check],
     table = html_table(["relation", "run", "calibrated model", "extended model", "floor"],
                        [[after.relation, after.run, _check_cell(before), _check_cell(after),
                          f"{after.floor:.2g} {after.unit}"] for before, after in pairs])
-    figure = plot_consistency(pairs, folder / "consistency.png")
-    return ("Consistency of what the rig measures twice", html_image(figure, folder) + table)
+    shown = [pair for pair in pairs if max(_sigmas(pair[0]), _sigmas(pair[1])) > 1.0]
+    caption = (f"<p>A relation is violated when its deviation is beyond {Z_VIOLATED:g} σ "
+               "<i>and</i> beyond its physical floor (the size below which it does not matter "
+               "to the rig, last column): an orange bar is beyond the σ line but within its "
+               f"floor. The chart shows the {len(shown)} checks beyond 1 σ under either model; "
+               f"the table all {len(pairs)}.</p>")
+    figure = plot_consistency(shown, folder / "consistency.png") if shown else None
+    image = html_image(figure, folder) if figure else ""
+    return ("Consistency of what the rig measures twice", caption + image + table)
 
 
 def paired_checks(calibrated: Sequence[Check], extended: Sequence[Check]
@@ -176,20 +238,25 @@ def plot_consistency(pairs: Sequence[tuple[Check | None, Check]], path: Path) ->
     """Each check's deviation in σ (log scale) under the calibrated model (pale) and the
     extended one, against the violation threshold; red: violated, orange: over the
     threshold but under its physical floor."""
-    fig, ax = plt.subplots(figsize=(9, 0.4 * len(pairs) + 1.4))
+    fig, ax = plt.subplots(figsize=(9, 0.5 * len(pairs) + 1.4))
     rows = np.arange(len(pairs))
-    for offset, alpha, label, index in ((-0.2, 0.4, "calibrated model", 0),
-                                        (0.2, 1.0, "extended model", 1)):
+    for offset, alpha, index in ((-0.2, 0.4, 0), (0.2, 1.0, 1)):
         checks = [pair[index] for pair in pairs]
         ax.barh(rows + offset, [_sigmas(c) for c in checks], height=0.4, alpha=alpha,
-                color=[_colour(c) for c in checks], label=label)
-    ax.axvline(Z_VIOLATED, color="k", linestyle="--", label=f"{Z_VIOLATED:g} σ")
+                color=[_colour(c) for c in checks])
+    ax.axvline(Z_VIOLATED, color="k", linestyle="--")
+    keys: list[matplotlib.artist.Artist] = [
+        matplotlib.patches.Patch(color="tab:grey", alpha=a, label=label)
+        for a, label in ((0.4, "calibrated model"), (1.0, "extended model"))]
+    keys.append(matplotlib.lines.Line2D([], [], color="k", linestyle="--",
+                                        label=f"{Z_VIOLATED:g} σ"))
     ax.set_xscale("log")
     ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-    ax.set_yticks(rows, [f"{after.relation} — {after.run}" for _, after in pairs], fontsize=7)
+    ax.set_yticks(rows, [textwrap.fill(f"{after.relation} — {after.run}", 40)
+                         for _, after in pairs], fontsize=7)
     ax.invert_yaxis()
     ax.set_xlabel("|deviation| / σ (red: violated; orange: over σ but under its physical floor)")
-    ax.legend(loc="lower right", fontsize=7)
+    ax.legend(handles=keys, loc="lower right", fontsize=7)
     fig.tight_layout()
     return save_figure(fig, path)
 
@@ -208,21 +275,28 @@ def _text(value: float | None) -> str:
     return "-" if value is None else f"{value:+.1f}"
 
 
+def _improvement(held_out: float | None) -> str:
+    """A held-out log-likelihood change as the improvement it is (positive: better)."""
+    return "-" if held_out is None else f"{-held_out:+.1f}"
+
+
 def diagnosis_summary(result: Diagnosis) -> str:
     """The terminal summary: candidates, baseline fit, verdict, findings, notes."""
     rows = [[f.cause, "yes" if f.accepted else "no", _maybe(f.delta_bic),
-             _maybe(f.held_out), f"{_fits(f.fit_before)} -> {_fits(f.fit_after)}"]
+             _maybe(None if f.held_out is None else -f.held_out),
+             f"{_fits(f.fit_before)} -> {_fits(f.fit_after)}"]
             for f in result.candidates]
-    lines = ["candidates:", text_table(["cause", "accepted", "dBIC", "held-out", "held-out fit %"],
+    lines = ["candidates:", text_table(["cause", "accepted", "dBIC", "held-out gain",
+                                        "held-out fit %"],
                                        rows) if rows else "  (none: the model has them all)"]
     lines.append(f"baseline fit %: {_fits(result.baseline)}")
     lines.append(f"VERDICT: {verdict_text(result)}")
+    lines.append(f"  {headline(result)}")
     if result.verdict == INCONCLUSIVE:
         lines.append("  the runs given cannot test every candidate, or none is left to check one "
                      "on: see the notes")
     for f in result.findings:
-        values = ", ".join(f"{k} = {v:.6g}" + (f" ± {f.std[k]:.2g}" if k in f.std else "")
-                           for k, v in f.parameters.items())
+        values = ", ".join(parameter_text(k, v, f.std.get(k)) for k, v in f.parameters.items())
         lines.append(f"  {f.cause}: {values}")
         if f.equation:
             lines.append(f"    where: the {f.equation} (seen in {f.channel})")

@@ -44,14 +44,19 @@ def plot_simulation(result: SimulationResult, path: Path) -> Path:
     axes[2].plot(t, result.pressure_pa / PA_PER_BAR, "m", label="brake pressure")
     axes[2].set_ylabel("pressure [bar]")
     current_axis = axes[2].twinx()
-    current_axis.plot(t, result.current_a, color="grey", lw=0.8, label="valve current")
+    current_axis.plot(t, result.current_a, color="grey", lw=0.8, ls="--", label="valve current")
     current_axis.set_ylabel("current [A]")
+    axes[2].set_zorder(current_axis.get_zorder() + 1)  # the pressure drawn over the current
+    axes[2].patch.set_visible(False)
     axes[3].plot(t, result.vertical_load_n / 1e3, "g", label="vertical load $F_z$")
     axes[3].plot(t, result.longitudinal_force_n / 1e3, "c", label="tyre force $F_x$")
     axes[3].set_ylabel("force [kN]")
     axes[3].set_xlabel("time [s]")
-    for axis in (axes[0], axes[2], axes[3]):
+    for axis in (axes[0], axes[3]):
         axis.legend(loc="upper right")
+    axes[2].legend(*(a + b for a, b in zip(axes[2].get_legend_handles_labels(),
+                                           current_axis.get_legend_handles_labels(),
+                                           strict=True)), loc="upper right")
     for axis in axes:
         axis.grid(alpha=0.3)
     fig.suptitle(f"{result.scenario.name}: {result.scenario.description} "
@@ -77,8 +82,10 @@ def plot_bode(responses: Sequence[FrequencyResponse], path: Path) -> Path:
                                   alpha=shade[response.speed_m_s], **style)
     axes[0, 0].set_title(r"$G_\lambda$: brake torque → slip")
     axes[0, 1].set_title(r"$G_\eta$: brake torque → normalised wheel deceleration")
-    axes[0, 0].set_ylabel("magnitude [dB re 1/(N m)]")
-    axes[1, 0].set_ylabel("phase [deg]")
+    for axis in axes[0]:
+        axis.set_ylabel("magnitude [dB re 1/(N m)]")
+    for axis in axes[1]:
+        axis.set_ylabel("phase [deg]")
     for axis in axes[1]:
         axis.set_xlabel("frequency [Hz]")
     for axis in axes.flat:

@@ -18,26 +18,31 @@ def plot_local_gains(before: Sequence[LocalGain], after: Sequence[LocalGain], pa
                      ) -> Path:
     """One panel per variable of VARIABLES (k_b over the model's, ±1σ, per band; calibrated
     and extended model), and one of the estimates along each run (calibrated model)."""
-    fig, axes = plt.subplots(1, len(VARIABLES) + 1, figsize=(4 * (len(VARIABLES) + 1), 3.6),
-                             sharey=True)
+    rows = -(-(len(VARIABLES) + 1) // 2)  # two panels a row: legible at page width
+    fig, grid = plt.subplots(rows, 2, figsize=(10, 3.6 * rows), sharey=True, squeeze=False)
+    axes = list(grid.flat)
     for ax, variable in zip(axes, VARIABLES, strict=False):
-        for gains, label, colour in ((before, "calibrated", "tab:red"),
-                                     (after, "extended", "tab:blue")):
+        for gains, label, colour, style in ((before, "calibrated", "tab:red", "o-"),
+                                            (after, "extended", "tab:blue", "s--")):
             for g in (g for g in gains if g.variable == variable):
-                ax.errorbar(g.centres, g.ratio, yerr=g.std, fmt="o-", ms=3, capsize=2,
-                            color=colour, label=f"{label}: {100 * g.change:+.1f} % ({g.z:.0f} σ)")
+                ax.errorbar(g.centres, g.ratio, yerr=g.std, fmt=style, ms=4, capsize=2,
+                            color=colour, alpha=0.8,
+                            label=f"{label}: {100 * g.change:+.1f} % ({g.z:.0f} σ)")
         ax.axhline(1.0, color="k", linewidth=0.8)
         ax.set_xlabel(f"{variable} [{VARIABLES[variable]}]")
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=8)
         ax.grid(alpha=0.3)
-    along = axes[-1]
+    along = axes[len(VARIABLES)]
     for g in (g for g in before if g.variable == "time in run"):
         along.plot(g.centres, g.ratio, "o-", ms=3, label=g.run)
     along.axhline(1.0, color="k", linewidth=0.8)
     along.set_xlabel("time since braking started [s] (calibrated)")
-    along.legend(fontsize=6)
+    along.legend(fontsize=7, ncols=2)
     along.grid(alpha=0.3)
-    axes[0].set_ylabel("local k_b / model's k_b")
+    for ax in axes[len(VARIABLES) + 1:]:
+        ax.set_visible(False)
+    for row in grid:
+        row[0].set_ylabel("local k_b / model's k_b")
     fig.tight_layout()
     return save_figure(fig, path)
 

@@ -25,14 +25,14 @@ def plot_montecarlo(rows: Sequence[dict[str, Any]], numbers: dict[str, Any], pat
     hist.set_xlabel("braking efficiency [-]")
     hist.set_ylabel("stops")
     hist.legend(fontsize=8)
+    locked = [r for r in good if r["lock_events"] > 0]
+    scatter.plot([r["entry_speed_m_s"] for r in locked],  # rings under the dots: both seen
+                 [r["stopping_distance_m"] for r in locked], "o", mfc="none", ms=9,
+                 color="black", zorder=1, label=f"wheel lock ({len(locked)})")
     for surface in surfaces:
         mine = [r for r in good if r["surface"] == surface]
         scatter.plot([r["entry_speed_m_s"] for r in mine],
-                     [r["stopping_distance_m"] for r in mine], ".", label=surface)
-    locked = [r for r in good if r["lock_events"] > 0]
-    scatter.plot([r["entry_speed_m_s"] for r in locked],
-                 [r["stopping_distance_m"] for r in locked], "x", color="black",
-                 label=f"wheel lock ({len(locked)})")
+                     [r["stopping_distance_m"] for r in mine], ".", zorder=2, label=surface)
     scatter.set_xlabel("entry speed [m/s]")
     scatter.set_ylabel("stopping distance [m]")
     scatter.legend(fontsize=8)

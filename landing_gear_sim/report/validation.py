@@ -23,25 +23,34 @@ from landing_gear_sim.report.pages import html_image, html_table, write_html
 
 
 def plot_overlay(comparison: RunComparison, path: Path) -> Path:
-    """Measured (black) and simulated (red) channels of one run (paper Figs. 13, 14)."""
+    """Measured (black) and simulated (red) channels of one run (paper Figs. 13, 14), each
+    with its residual below it: where the two traces overlap too closely to tell apart, the
+    residual shows the difference (issue 32)."""
     channels = list(comparison.scores)
-    fig, axes = plt.subplots(len(channels), 1, figsize=(9, 2.2 * len(channels) + 0.6),
-                             sharex=True, squeeze=False)
+    fig, axes = plt.subplots(2 * len(channels), 1, figsize=(9, 3.0 * len(channels) + 0.8),
+                             sharex=True, squeeze=False,
+                             gridspec_kw={"height_ratios": [2, 1] * len(channels)})
     m, s = comparison.measured, comparison.simulated
     n = min(len(m), len(s))
     t = m.time_s[:n] - m.time_s[0]
-    for axis, channel in zip(axes[:, 0], channels, strict=True):
+    for i, channel in enumerate(channels):
         factor, unit = DISPLAY_UNITS[channel]
-        axis.plot(t, getattr(m, channel)[:n] * factor, "k", lw=0.7, label="measured")
-        axis.plot(t, getattr(s, channel)[:n] * factor, "r", lw=0.9, label="simulated")
+        top, bottom = axes[2 * i, 0], axes[2 * i + 1, 0]
+        measured, simulated = getattr(m, channel)[:n] * factor, getattr(s, channel)[:n] * factor
+        top.plot(t, measured, "k", lw=0.7, label="measured")
+        top.plot(t, simulated, "r", lw=0.9, label="simulated")
+        top.set_ylabel(f"{CHANNELS[channel].split(' [')[0]}\n[{unit}]")
         score = comparison.scores[channel]
-        axis.set_ylabel(f"{CHANNELS[channel].split(' [')[0]}\n[{unit}]")
-        axis.set_title(f"fit {score.fit_percent:.1f} %", fontsize=8, loc="right")
-        axis.grid(alpha=0.3)
-    axes[0, 0].legend(loc="upper right", fontsize=8)
+        top.set_title(f"fit {score.fit_percent:.1f} %, RMSE {score.rmse * factor:.3g} {unit}",
+                      fontsize=8, loc="right")
+        bottom.plot(t, measured - simulated, "b", lw=0.5)
+        bottom.set_ylabel(f"residual\n[{unit}]")
+        for axis in (top, bottom):
+            axis.grid(alpha=0.3)
+    fig.legend(*axes[0, 0].get_legend_handles_labels(), loc="upper center", ncols=2,
+               fontsize=8, frameon=False)
     axes[-1, 0].set_xlabel("time [s]")
-    fig.suptitle(f"{m.name} ({comparison.kind})")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 0.97))
     return save_figure(fig, path)
 
 
@@ -113,12 +122,31 @@ def scores_header() -> list[str]:
     return ["run", "kind", *(c.split("_")[0] + " fit %" for c in CHANNELS)]
 
 
+def errors_table(comparisons: Sequence[RunComparison]) -> tuple[list[str], list[list[str]]]:
+    """Header and rows: RMSE / max |error| per run and channel, in the plots' units."""
+    header = ["run", *(f"{c.split('_')[0]} [{DISPLAY_UNITS[c][1]}]" for c in CHANNELS)]
+    rows = []
+    for c in comparisons:
+        cells = [f"{c.scores[ch].rmse * DISPLAY_UNITS[ch][0]:.3g} / "
+                 f"{c.scores[ch].max_error * DISPLAY_UNITS[ch][0]:.3g}" if ch in c.scores
+                 else "" for ch in CHANNELS]
+        rows.append([c.measured.name, *cells])
+    return header, rows
+
+
+FIT_DEFINITION = ("<p>fit % = 100·(1 − ‖y − ŷ‖ / ‖y − ȳ‖), y measured, ŷ simulated, ȳ the "
+                  "measured mean: 100 is a perfect match, 0 no better than the mean, and it "
+                  "can be negative. Each run is simulated with its measured input.</p>")
+
+
 def write_validation_report(validation: Validation, folder: Path, title: str) -> Path:
     """The validation page ``folder/index.html`` with its figures; returns the page."""
     sources = ", ".join(validation.params.sources)
     sections = [("Model", html_table(["parameters from"], [[sources]])),
-                ("Fit per run and channel",
-                 html_table(scores_header(), scores_table(validation.comparisons)))]
+                ("Fit per run and channel", FIT_DEFINITION
+                 + html_table(scores_header(), scores_table(validation.comparisons))),
+                ("RMSE / max |error| per run and channel",
+                 html_table(*errors_table(validation.comparisons)))]
     if validation.friction_points is not None:
         figure = plot_friction(*validation.friction_points, validation.params,
                                folder / "friction.png")
@@ -128,5 +156,5 @@ def write_validation_report(validation: Validation, folder: Path, title: str) ->
         sections.append((f"Actuator frequency response ({frf.run})", html_image(figure, folder)))
     for c in validation.comparisons:
         figure = plot_overlay(c, folder / f"{c.measured.name}.png")
-        sections.append((f"{c.measured.name}", html_image(figure, folder)))
+        sections.append((f"{c.measured.name} ({c.kind})", html_image(figure, folder)))
     return write_html(folder / "index.html", title, sections)

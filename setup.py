@@ -9,7 +9,7 @@ NODES = ("plant", "actuator", "loading_device", "profile", "recorder", "replay")
 
 setup(
     name=PACKAGE,
-    version="0.6.0",
+    version="0.7.0",
     description="Digital twin of an aircraft landing-gear anti-skid test rig",
     license="Apache-2.0",
     python_requires=">=3.10",

@@ -4,4 +4,4 @@ The physics and analysis here never import ROS; ``landing_gear_sim.ros.nodes`` h
 the thin rclpy adapters.
 """
 
-__version__ = "0.6.0"
+__version__ = "0.7.0"

@@ -19,10 +19,11 @@ import pytest
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.cli import main
 from landing_gear_sim.diagnosis.catalogue import CATALOGUE, gear_walk_key_parameters
-from landing_gear_sim.diagnosis.diagnose import diagnose
+from landing_gear_sim.diagnosis.diagnose import Diagnosis, diagnose
+from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.scoring import split_runs
 from landing_gear_sim.errors import DiagnosisError
-from landing_gear_sim.report.diagnosis import parameter_text
+from landing_gear_sim.report.diagnosis import headline, parameter_text
 from msg_tools.csv_io import read_csv, write_csv
 from msg_tools.io import read_campaign
 
@@ -221,6 +222,24 @@ def test_cli_writes_the_contract_json_and_the_report(reference, tmp_path, capsys
 ])
 def test_a_parameter_reads_in_engineering_units(key, value, std, text):
     assert parameter_text(key, value, std) == text
+
+
+def test_the_one_sentence_verdict_names_both_of_two_effects(reference):
+    """The independent campaign I02 holds a delay and an offset: both on the first line."""
+    def finding(cause, key, value, std, held_out):
+        return Finding(cause=cause, parameters={key: value}, std={key: std}, evidence="",
+                       fit_before={"pressure_pa": 95.5}, fit_after={"pressure_pa": 96.4},
+                       delta_bic=-1667.0, held_out=held_out, accepted=True)
+
+    result = Diagnosis(verdict="actuator_delay", findings=[
+        finding("actuator_delay", "delay_s", 0.012, 0.00029, -1494.4),
+        finding("pressure_sensor_offset", "offset_pa", 99590.0, 390.0, -10447.5)],
+        candidates=[], baseline={}, start=reference, calibrated=reference, extended=reference,
+        signatures_before=[], signatures_after=[])
+    assert headline(result) == (
+        "actuator_delay: delay = 12 ± 0.29 ms; on runs it was not fitted on, the extended "
+        "model is better by 1494 log-likelihood units (pressure 95.5 → 96.4 %). Also "
+        "pressure_sensor_offset: offset = 0.9959 ± 0.0039 bar.")
 
 
 def test_cli_diagnose_on_a_missing_folder_is_one_error_line(capsys):

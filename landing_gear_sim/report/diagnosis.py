@@ -18,6 +18,7 @@ import numpy as np
 
 from landing_gear_sim.calibration.measured import CHANNELS
 from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
+from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.relations import Z_VIOLATED, Check
 from landing_gear_sim.diagnosis.residuals import Spectrum
 from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, HELD_OUT_THRESHOLD
@@ -125,15 +126,21 @@ def headline(result: Diagnosis) -> str:
         return {"none": "The calibrated model explains every run: nothing is missing.",
                 INCONCLUSIVE: "Inconclusive: the runs cannot test every candidate (see the "
                 "notes)."}.get(result.verdict, f"{result.verdict}.")
-    best = result.findings[0]
-    values = ", ".join(parameter_text(k, v, best.std.get(k)) for k, v in best.parameters.items())
-    sentence = f"{verdict_text(result)}: {values}" if values else verdict_text(result)
+    best, *others = result.findings
+    sentence = f"{verdict_text(result)}{_values(best)}"
     if best.held_out is not None and best.held_out < 0:
         gain = ", ".join(f"{c.split('_')[0]} {best.fit_before[c]:.1f} → {best.fit_after[c]:.1f} %"
                          for c in best.fit_after if c in best.fit_before)
         sentence += (f"; on runs it was not fitted on, the extended model is better by "
                      f"{-best.held_out:.0f} log-likelihood units" + (f" ({gain})" if gain else ""))
-    return sentence + "."
+    also = "; ".join(f"{f.cause}{_values(f)}" for f in others)  # two effects at once: both
+    return sentence + "." + (f" Also {also}." if also else "")
+
+
+def _values(finding: Finding) -> str:
+    values = ", ".join(parameter_text(k, v, finding.std.get(k))
+                       for k, v in finding.parameters.items())
+    return f": {values}" if values else ""
 
 
 def _structure_table(result: Diagnosis) -> str:

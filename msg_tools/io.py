@@ -111,17 +111,25 @@ def read_campaign(folder: Path, mapping: Mapping | None = None,
         if progress and len(sources) > 1:
             progress(f"reading {number}/{len(sources)}: {source.relative_to(folder)}")
         try:
-            run = read_run(source, mapping, _campaign_name(folder, source))
+            parts, notes = _read_parts(source, mapping, _campaign_name(folder, source))
         except RunFormatError as exc:
             problems.append(str(exc))
             continue
-        split = split_at_gaps(run)
-        runs.extend(split.parts)
-        problems.extend((*run.notes, *split.notes))
+        runs.extend(parts)
+        problems.extend(notes)
     if not runs:
         raise RunFormatError(f"{folder}: no readable run" +
                              (f" ({'; '.join(problems)})" if problems else ""))
     return Campaign(folder, tuple(runs), tuple(problems))
+
+
+def _read_parts(path: Path, mapping: Mapping | None, name: str | None = None
+                ) -> tuple[tuple[Run, ...], tuple[str, ...]]:
+    """The run of ``path`` as its parts (split at long gaps), and what reading and
+    splitting it had to say."""
+    run = read_run(path, mapping, name)
+    split = split_at_gaps(run)
+    return tuple(split.parts), (*run.notes, *split.notes)
 
 
 def _campaign_name(folder: Path, source: Path) -> str:
@@ -145,10 +153,9 @@ def read_runs(paths: Sequence[Path], mapping: Mapping | None = None) -> Campaign
             runs.extend(campaign.runs)
             problems.extend(campaign.problems)
         else:
-            run = read_run(path, mapping)
-            split = split_at_gaps(run)
-            runs.extend(split.parts)
-            problems.extend((*run.notes, *split.notes))
+            parts, notes = _read_parts(path, mapping)
+            runs.extend(parts)
+            problems.extend(notes)
     names = [r.name for r in runs]
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:

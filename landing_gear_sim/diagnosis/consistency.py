@@ -154,9 +154,12 @@ def _valve_direction(run: ClassifiedRun, params: RigParameters) -> Check | None:
     last (only where it has changed slowly for SETTLED_S and the valve is between its
     dead-band and saturation): a static map cannot tell the two apart, a valve with play
     can. Positive: more pressure on the way down."""
+    noise = _log_noise_a(run)
+    if _unreadable(run, noise):
+        return None
     model = actuator_pressure(params, logged_to_held(run.command_a), run.rate_hz)
     residual = run.pressure_pa - SensorModel.of(params).pressure_channel(run.time_s, model)
-    change = _current_rate(run)
+    change = _current_rate(run, noise)
     last = np.maximum.accumulate(np.where(change != 0.0, np.arange(change.size), 0))
     direction = np.sign(change[last])
     window = max(1, round(SETTLED_S * run.rate_hz))
@@ -165,7 +168,7 @@ def _valve_direction(run: ClassifiedRun, params: RigParameters) -> Check | None:
     band = (model > 2 * PRESSURE_FLOOR_PA) & (model < 0.9 * params.number(
         "actuator.max_pressure_pa"))
     falling, rising = (residual[slow & band & (direction == s)] for s in (-1.0, 1.0))
-    if min(falling.size, rising.size) < MIN_CHECK_S * run.rate_hz or _unreadable(run):
+    if min(falling.size, rising.size) < MIN_CHECK_S * run.rate_hz:
         return None
     std = math.sqrt(sum(float(np.var(r)) / effective_count(r - r.mean())
                         for r in (falling, rising)))
@@ -173,11 +176,11 @@ def _valve_direction(run: ClassifiedRun, params: RigParameters) -> Check | None:
                  float(falling.mean() - rising.mean()), std, PRESSURE_FLOOR_PA, "Pa")
 
 
-def _unreadable(run: ClassifiedRun) -> bool:
+def _unreadable(run: ClassifiedRun, noise_a: float) -> bool:
     """A fast actuator run whose current log is noisy: fed the log (a sweep to 100 Hz keeps
     it), a valve with play follows the noise both ways, and which way the current last
     moved means nothing (the quasi-static ramp, fed its denoised command, still tells)."""
-    return run.kind is RunKind.ACTUATOR_DYNAMIC and _log_noise_a(run) > NOISY_CURRENT_A
+    return run.kind is RunKind.ACTUATOR_DYNAMIC and noise_a > NOISY_CURRENT_A
 
 
 def _log_noise_a(run: ClassifiedRun) -> float:
@@ -189,12 +192,11 @@ def _log_noise_a(run: ClassifiedRun) -> float:
     return float(np.quantile([current_noise_a(p) for p in pieces], NOISE_QUANTILE))
 
 
-def _current_rate(run: ClassifiedRun) -> np.ndarray:
+def _current_rate(run: ClassifiedRun, noise: float) -> np.ndarray:
     """How fast the valve's current changes [A/s], (n,); 0 where it holds. A noisy log's
     rate is the least-squares slope over RATE_WINDOW_S, counted only beyond RATE_NOISE_Z
     times that slope's noise (10 mA of noise made every sample a 'fast change' on its own,
     and the relation went unchecked)."""
-    noise = _log_noise_a(run)
     if noise <= NOISY_CURRENT_A:
         return np.diff(run.current_a, prepend=run.current_a[0]) * run.rate_hz
     width = 2 * round(RATE_WINDOW_S * run.rate_hz / 2) + 1

@@ -138,9 +138,13 @@ def headline(result: Diagnosis) -> str:
 
 
 def _values(finding: Finding) -> str:
-    values = ", ".join(parameter_text(k, v, finding.std.get(k))
-                       for k, v in finding.parameters.items())
+    values = _parameters(finding)
     return f": {values}" if values else ""
+
+
+def _parameters(finding: Finding) -> str:
+    return ", ".join(parameter_text(k, v, finding.std.get(k))
+                     for k, v in finding.parameters.items())
 
 
 def _structure_table(result: Diagnosis) -> str:
@@ -165,15 +169,15 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
          "after", "evidence"],
         [[f.cause + (f" ({f.family}): {f.term}" if f.term else "")
           + (f" — in the {f.equation} ({f.channel})" if f.equation else ""),
-          ", ".join(parameter_text(k, v, f.std.get(k)) for k, v in f.parameters.items()),
-          _text(f.delta_bic), _improvement(f.held_out), fits(f.fit_before), fits(f.fit_after),
+          _parameters(f),
+          _text(f.delta_bic), _text(_gain(f.held_out)), fits(f.fit_before), fits(f.fit_after),
           f.evidence] for f in result.findings])
     candidates = html_table(
         ["cause", "accepted", "key parameters", "ΔBIC", "held-out improvement", "fitted on",
          "checked on"],
         [[f.cause, "yes" if f.accepted else "no",
           ", ".join(f"{k} = {v:.4g}" for k, v in f.parameters.items()), _text(f.delta_bic),
-          _improvement(f.held_out), ", ".join(f.fitted_on), ", ".join(f.checked_on)]
+          _text(_gain(f.held_out)), ", ".join(f.fitted_on), ", ".join(f.checked_on)]
          for f in result.candidates])
     verdict = (f"<p><b>{html.escape(headline(result))}</b></p><p>Starting model: "
                f"{', '.join(result.start.sources)}. ΔBIC = BIC(with) − BIC(without) on the "
@@ -282,15 +286,15 @@ def _text(value: float | None) -> str:
     return "-" if value is None else f"{value:+.1f}"
 
 
-def _improvement(held_out: float | None) -> str:
+def _gain(held_out: float | None) -> float | None:
     """A held-out log-likelihood change as the improvement it is (positive: better)."""
-    return "-" if held_out is None else f"{-held_out:+.1f}"
+    return None if held_out is None else -held_out
 
 
 def diagnosis_summary(result: Diagnosis) -> str:
     """The terminal summary: candidates, baseline fit, verdict, findings, notes."""
     rows = [[f.cause, "yes" if f.accepted else "no", _maybe(f.delta_bic),
-             _maybe(None if f.held_out is None else -f.held_out),
+             _maybe(_gain(f.held_out)),
              f"{_fits(f.fit_before)} -> {_fits(f.fit_after)}"]
             for f in result.candidates]
     lines = ["candidates:", text_table(["cause", "accepted", "dBIC", "held-out gain",
@@ -303,8 +307,7 @@ def diagnosis_summary(result: Diagnosis) -> str:
         lines.append("  the runs given cannot test every candidate, or none is left to check one "
                      "on: see the notes")
     for f in result.findings:
-        values = ", ".join(parameter_text(k, v, f.std.get(k)) for k, v in f.parameters.items())
-        lines.append(f"  {f.cause}: {values}")
+        lines.append(f"  {f.cause}: {_parameters(f)}")
         if f.equation:
             lines.append(f"    where: the {f.equation} (seen in {f.channel})")
         if f.term:

@@ -56,6 +56,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/io.py
 	$(BIN)/python bench/montecarlo.py
 	$(BIN)/python bench/history.py
+	$(BIN)/python bench/stopping.py
 
 clean:
 	rm -rf $(VENV) out build install log .pytest_cache

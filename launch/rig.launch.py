@@ -3,13 +3,18 @@
 Thin on purpose: the nodes, their parameters and links come from
 ``landing_gear_sim.ros.graph.describe``, the same description ``landing-gear-sim rig``
 starts without a ROS install. Arguments: see ``graph.LAUNCH_ARGUMENTS``.
+
+A node that exits non-zero fails the run: launch shuts the graph down and returns 1
+(an error raised in an event handler is launch's one way to a non-zero exit).
 """
 
 from launch import LaunchDescription
-from launch.actions import DeclareLaunchArgument, OpaqueFunction
+from launch.actions import DeclareLaunchArgument, OpaqueFunction, RegisterEventHandler
+from launch.event_handlers import OnProcessExit
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
 
+from landing_gear_sim.errors import GraphError
 from landing_gear_sim.ros.graph import LAUNCH_ARGUMENTS, PACKAGE, describe, options_from_arguments
 
 
@@ -22,7 +27,14 @@ def _nodes(context):
             for node in describe(options)]
 
 
+def _fail_the_run(event, context):
+    if event.returncode != 0:
+        raise GraphError(f"{event.process_name} exited with code {event.returncode}: "
+                                "the run failed")
+
+
 def generate_launch_description():
     arguments = [DeclareLaunchArgument(name, default_value=default, description=text)
                  for name, (default, text) in LAUNCH_ARGUMENTS.items()]
-    return LaunchDescription([*arguments, OpaqueFunction(function=_nodes)])
+    return LaunchDescription([*arguments, OpaqueFunction(function=_nodes),
+                              RegisterEventHandler(OnProcessExit(on_exit=_fail_the_run))])

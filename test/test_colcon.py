@@ -9,6 +9,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 from typing import Any
 
@@ -185,23 +186,30 @@ def test_ros2_launch_with_an_external_controller_runs_the_example_node(workspace
     assert len(recorded) == 1500 and recorded.pressure_pa.max() > 20e5
 
 
+def _long_launch(workspace: Path, tmp_path: Path, bag: Path) -> subprocess.Popen:
+    """`ros2 launch` of a run without brake for 10 min, in a session of its own, once its
+    run has started: still running when a test is done with it, however fast the graph
+    runs (a 3 bar stop reached the stop speed after 111 s: at 1.6x real time that ended
+    the run, and its nodes, before the last `ros2 param`)."""
+    from landing_gear_sim.model.parameters import load_parameters
+
+    long_params = tmp_path / "long.yaml"
+    load_parameters(overrides={"rig_test.max_duration_s": 600.0}).to_yaml(long_params)
+    launch = _sourced(workspace, "exec ros2 launch landing_gear_sim rig.launch.py "
+                      f"profile:=constant pressure_bar:=0 bag:={bag} "
+                      f"params_file:={long_params}", start_new_session=True)
+    next(line for line in iter(launch.stdout.readline, "") if "run starts" in line)
+    return launch
+
+
 @needs_ros2
 def test_ros2_tools_on_a_running_rig_a_second_rig_beside_it_and_ctrl_c(workspace, tmp_path,
                                                                         short_params):
     """`ros2 topic hz/echo`, `ros2 param list/get/set` on each node, a second rig in its own
     namespace on the same domain, then a terminal's Ctrl-C on the first `ros2 launch`."""
-    from landing_gear_sim.model.parameters import load_parameters
-
-    bag, long_params = tmp_path / "bag", tmp_path / "long.yaml"
-    # no brake, 10 min: still running when the tools are done, however fast the graph runs
-    # (a 3 bar stop reached the stop speed after 111 s: at 1.6x real time that ended the
-    # run, and its nodes, before the last `ros2 param`)
-    load_parameters(overrides={"rig_test.max_duration_s": 600.0}).to_yaml(long_params)
-    launch = _sourced(workspace, "exec ros2 launch landing_gear_sim rig.launch.py "
-                      f"profile:=constant pressure_bar:=0 bag:={bag} "
-                      f"params_file:={long_params}", start_new_session=True)
+    bag = tmp_path / "bag"
+    launch = _long_launch(workspace, tmp_path, bag)
     try:
-        next(line for line in iter(launch.stdout.readline, "") if "run starts" in line)
         code, hz = _ros(workspace, "timeout -s INT 12 ros2 topic hz /rig/wheel/joint_states")
         rates = [float(x) for x in re.findall(r"average rate: ([0-9.]+)", hz)]
         assert rates and rates[-1] > 100, hz  # the average over the last window
@@ -263,3 +271,36 @@ ros2 launch landing_gear_sim rig.launch.py profile:=osc-low bag:={bag}
     assert result.returncode == 0, output[-3000:]
     assert "Traceback" not in output and "process has died" not in output, output[-3000:]
     assert "bag closed" in output and (bag / "metadata.yaml").is_file()
+
+
+@needs_ros2
+def test_ros2_launch_exits_non_zero_naming_the_node_whose_start_failed(workspace, tmp_path,
+                                                                      short_params):
+    """An existing bag path: the recorder exits 2, and the run is a failure everywhere (it
+    once waited out its timeouts and `ros2 launch` returned 0)."""
+    bag = tmp_path / "bag"
+    bag.mkdir()
+    code, output = _ros(workspace, f"ros2 launch landing_gear_sim rig.launch.py bag:={bag} "
+                                   f"params_file:={short_params}", timeout=120)
+    assert code != 0, output[-3000:]
+    assert re.search(r"recorder\S* exited with code 2", output), output[-3000:]
+    assert "Traceback" not in output
+
+
+@needs_ros2
+def test_sigterm_to_ros2_launch_leaves_no_node_running(workspace, tmp_path):
+    """How systemd and supervisors stop things: TERM to the launch process alone. Launch
+    exits at once without its nodes; they must not run on as orphans."""
+    bag = tmp_path / "bag"
+    launch = _long_launch(workspace, tmp_path, bag)
+    try:
+        launch.send_signal(signal.SIGTERM)
+        launch.communicate(timeout=60)
+        deadline = time.monotonic() + 30
+        while subprocess.run(["pgrep", "-s", str(launch.pid)]).returncode == 0:
+            assert time.monotonic() < deadline, "nodes still running 30 s after launch ended"
+            time.sleep(0.2)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(launch.pid, signal.SIGKILL)
+    assert (bag / "metadata.yaml").is_file()  # the recorder closed its bag on the way out

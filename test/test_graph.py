@@ -189,17 +189,19 @@ def test_launch_file_starts_exactly_the_described_nodes(monkeypatch, tmp_path):
             return context[self.name]
 
     stubs = {"launch": {"LaunchDescription": lambda items: items},
-             "launch.actions": {"DeclareLaunchArgument": Record, "OpaqueFunction": Record},
+             "launch.actions": {"DeclareLaunchArgument": Record, "OpaqueFunction": Record,
+                                "RegisterEventHandler": Record},
+             "launch.event_handlers": {"OnProcessExit": Record},
              "launch.substitutions": {"LaunchConfiguration": LaunchConfiguration},
              "launch_ros": {}, "launch_ros.actions": {"Node": Node}}
     for name, attributes in stubs.items():
         monkeypatch.setitem(sys.modules, name, types.SimpleNamespace(**attributes))
     items = runpy.run_path(str(ROOT / "launch" / "rig.launch.py"))["generate_launch_description"]()
-    declared = {item.args[0] for item in items[:-1]}
+    declared = {item.args[0] for item in items[:-2]}
     assert declared == set(LAUNCH_ARGUMENTS)
     context = {name: default for name, (default, _) in LAUNCH_ARGUMENTS.items()}
     context["bag"] = str(tmp_path / "bag")
-    items[-1].kwargs["function"](context)
+    items[-2].kwargs["function"](context)
     options, _ = options_from_arguments(context)
     described = describe(options)
     assert [m["executable"] for m in made] == [n.name for n in described]

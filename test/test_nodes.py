@@ -23,6 +23,7 @@ from landing_gear_sim.ros.graph import load_scenario
 from landing_gear_sim.ros.launcher import ros_environment
 from msg_tools.bag_read import read_bag
 from msg_tools.csv_io import format_csv, write_csv
+from msg_tools.run import Run
 
 pytest.importorskip("rclpy")
 
@@ -104,28 +105,44 @@ def test_a_signal_to_the_whole_process_group_stops_everything_cleanly(tmp_path, 
         assert "Traceback" not in rest and not bag.exists(), rest[-3000:]
 
 
-def test_a_killed_recorder_leaves_a_readable_bag_and_the_run_goes_on(tmp_path, start):
+def test_a_killed_recorder_fails_the_run_at_once_and_leaves_a_readable_bag(tmp_path, start):
+    """A participant's death is the run's: the graph stops and `rig` exits 1 naming it (it
+    once ran on to a "successful" end without its recorder)."""
     bag = tmp_path / "bag"
-    run = {**SHORT, "rig_test.max_duration_s": 6.0}
+    run = {**SHORT, "rig_test.max_duration_s": 30.0}
     launcher = start(rig_command("--profile", "osc-low", "--bag", str(bag), overrides=run))
     wait_for(lambda: (bag / "metadata.yaml").exists() and len(list(bag.glob("bag_*"))) >= 2)
     os.kill(_pid_of("nodes.recorder", launcher), signal.SIGKILL)
     _, stderr = launcher.communicate(timeout=120)
-    assert launcher.returncode == 0, stderr[-2000:]
-    assert "recorder died" in stderr
+    assert launcher.returncode == 1, stderr[-2000:]
+    assert "the run failed (recorder exit code -9)" in stderr, stderr[-2000:]
     survived = read_bag(bag)  # readable as it is, no repair step
     assert survived.time_s[-1] >= 0.5
     np.testing.assert_allclose(survived.pressure_pa, offline_run(run).pressure_pa[:len(survived)],
                                rtol=1e-9, atol=1e-6)
 
 
-def test_a_killed_actuator_neither_hangs_nor_crashes_the_plant(tmp_path, start):
+def test_a_killed_actuator_stops_the_graph_at_once_naming_it(tmp_path, start):
+    bag = tmp_path / "bag"
+    run = {**SHORT, "rig_test.max_duration_s": 30.0}
+    launcher = start(rig_command("--profile", "osc-low", "--bag", str(bag), overrides=run))
+    wait_for(lambda: (bag / "metadata.yaml").exists())
+    os.kill(_pid_of("nodes.actuator", launcher), signal.SIGKILL)
+    _, stderr = launcher.communicate(timeout=120)
+    assert launcher.returncode == 1, stderr[-2000:]
+    assert "node actuator died (exit code -9)" in stderr, stderr[-2000:]
+    assert len(read_bag(bag)) < 30000  # stopped, not run on to the end without its valve
+
+
+def test_a_hung_actuator_neither_hangs_nor_crashes_the_plant(tmp_path, start):
+    """A peer alive but silent (stopped, starved): after --timeout the plant holds its
+    input at the safe pressure and runs on, so the recorder is still fed."""
     bag = tmp_path / "bag"
     run = {**SHORT, "rig_test.max_duration_s": 4.0}
     launcher = start(rig_command("--profile", "osc-low", "--bag", str(bag), "--timeout", "0.5",
                                  overrides=run))
     wait_for(lambda: (bag / "metadata.yaml").exists())
-    os.kill(_pid_of("nodes.actuator", launcher), signal.SIGKILL)
+    os.kill(_pid_of("nodes.actuator", launcher), signal.SIGSTOP)
     _, stderr = launcher.communicate(timeout=120)
     # a participant missing is a failed run, never a success, though the bag is complete
     assert launcher.returncode == 1, stderr[-2000:]
@@ -147,14 +164,22 @@ def test_realtime_graph_follows_the_wall_clock_stamped_in_ros_time(tmp_path):
     # stamps are the ROS (system) time each sample was due, on the exact grid
     assert wall_started < recorded.time_s[0] < time.time()
     np.testing.assert_allclose(np.diff(recorded.time_s), 1e-3, atol=1e-6)  # float64 at 1.8e9 s
-    # the loading device answers from the first sample on (its JIT once made it ~0.6 s late,
-    # and the wheel rolled unloaded): the rising load is never 0.1 s behind the offline run
-    # (a few ms when the machine is quiet; tens of ms beside the rest of the suite)
-    rising = offline_run(SHORT).vertical_load_n[:300]
-    assert np.all(recorded.vertical_load_n[100:300] >= 0.95 * rising[:200])
+    # the loading device answers within the run. How soon is what the scheduler gives: a
+    # few ms on a quiet machine, 0.1-0.5 s measured beside a busy suite, which is also the
+    # size of the JIT delay it once had (now compiled before the handshake), so real time
+    # cannot tell the two apart and the test asserts only what it can promise
+    assert _load_lag_s(recorded, offline_run(SHORT)) < 1.0
     rtf = float(re.search(r"real-time factor ([0-9.]+)", done.stderr).group(1))
     assert rtf <= 1.05  # paced by the wall clock: never faster (slower only if starved)
     assert "real-time pacing: p99 period jitter" in done.stderr  # how well, said at the end
+
+
+def _load_lag_s(recorded: Run, offline: Run) -> float:
+    """How much later the recorded load first reaches half the offline run's final load."""
+    half = 0.5 * offline.vertical_load_n[-1]
+    first = [int(np.argmax(run.vertical_load_n >= half)) for run in (recorded, offline)]
+    assert recorded.vertical_load_n[first[0]] >= half, "the recorded load never rose"
+    return (first[0] - first[1]) * 1e-3
 
 
 def test_replay_publishes_a_run_that_the_recorder_writes_back(tmp_path, reference):
@@ -269,6 +294,34 @@ def test_a_signal_to_a_lone_node_ends_it_cleanly(tmp_path, start, node, sig):
     assert "Traceback" not in errors
 
 
+def test_a_node_whose_parent_is_killed_stops_cleanly_instead_of_running_on(tmp_path):
+    """A supervisor's SIGTERM ends `ros2 launch` in milliseconds without its nodes: a node
+    whose parent is gone takes it as a stop request (no orphan, the bag complete)."""
+    bag, log = tmp_path / "bag", tmp_path / "recorder.log"
+    node = f"{sys.executable} -m landing_gear_sim.ros.nodes.recorder --ros-args -p bag:={bag}"
+    parent = subprocess.Popen(["sh", "-c", f"{node} 2>{log} & echo $!; wait"],
+                              stdout=subprocess.PIPE, text=True)
+    child = int(parent.stdout.readline())
+    try:
+        wait_for(lambda: log.exists() and "running" in log.read_text())
+        parent.kill()
+        parent.wait()
+        wait_for(lambda: not _alive(child), timeout_s=30)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(child, signal.SIGKILL)
+    assert "Traceback" not in log.read_text()
+    assert (bag / "metadata.yaml").exists()
+
+
+def _alive(pid: int) -> bool:
+    """Whether ``pid`` runs (a zombie has ended: its stat state is Z)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+
+
 def _wait_until_running(process: subprocess.Popen) -> None:
     deadline = time.monotonic() + 60
     while "running" not in (line := process.stderr.readline()) and time.monotonic() < deadline:
@@ -352,3 +405,33 @@ def test_two_rigs_share_a_domain_each_in_its_namespace(tmp_path, start):
         assert len(graph) == len(offline) == 1500  # one run each: no sample of the other
         np.testing.assert_allclose(graph.wheel_speed_rad_s, offline.wheel_speed_rad_s,
                                    rtol=1e-9, atol=1e-6)
+
+
+def test_a_command_topic_remapped_on_its_source_and_the_actuator_is_found(tmp_path):
+    """`-r brake/current_ref:=brake/cmd` on the profile and the actuator, as ROS users remap:
+    the plant finds the command source through the graph (it once looked the literal name up
+    and refused to start, exit 4)."""
+    from landing_gear_sim.ros.graph import describe, options_from_arguments
+    from landing_gear_sim.ros.launcher import node_command
+
+    params_file = tmp_path / "short.yaml"
+    load_parameters(overrides=SHORT).to_yaml(params_file)
+    options, _ = options_from_arguments({"profile": "osc-low"})
+    remap = ["-r", "brake/current_ref:=brake/cmd"]
+    commands = {node.name: node_command(node, params_file)
+                + (remap if node.name in ("profile", "actuator") else [])
+                for node in describe(options)}
+    processes = {name: subprocess.Popen(command, env=ros_environment(), text=True,
+                                        stderr=subprocess.PIPE)
+                 for name, command in commands.items()}
+    try:
+        _, plant_errors = processes["plant"].communicate(timeout=180)
+        for process in processes.values():
+            process.communicate(timeout=60)  # the run's end reaches every node
+    finally:
+        for process in processes.values():
+            if process.poll() is None:
+                process.kill()
+    assert processes["plant"].returncode == 0, plant_errors[-2000:]
+    assert "run ends after 1500 samples" in plant_errors
+    assert all(p.returncode == 0 for p in processes.values())

@@ -10,13 +10,14 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from landing_gear_sim.calibration.braking import LOADED_N, Braking, hub_speed
-from landing_gear_sim.calibration.measured import simulate_run
+from landing_gear_sim.calibration.measured import simulate_all
 from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
 from landing_gear_sim.calibration.statistics import Estimate, covariance_std, run_weights
 from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model.elements import burckhardt_mu, slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import load_factor_at, rolling_radius_at
+from msg_tools.run import Run
 
 KEYS = ("friction.theta1", "friction.theta2", "friction.theta3")
 REFINE_BOUNDS = (0.2, 5.0)  # output-error refinement stays within these factors of the start
@@ -96,19 +97,20 @@ def refine_friction(runs: Sequence[ClassifiedRun], p: RigParameters, jackknife: 
     windows = [braking_window(r, p) for r in runs]
     weights = run_weights([int(w.sum()) for w in windows])
 
-    def slip_error(run: ClassifiedRun, window: np.ndarray, trial: RigParameters) -> np.ndarray:
+    def slip_error(run: ClassifiedRun, simulated: Run, window: np.ndarray, ratio: float
+                   ) -> np.ndarray:
         # wheel-speed error less what the flywheel-speed error explains: a common speed
         # offset (noisy initial speed, drag) is not the friction curve's doing
-        simulated = simulate_run(run, trial)[0]
-        ratio = trial.number("flywheel.radius_m") / trial.number("wheel.unloaded_radius_m")
         wheel = simulated.wheel_speed_rad_s[window] - run.wheel_speed_rad_s[window]
         flywheel = simulated.flywheel_speed_rad_s[window] - run.flywheel_speed_rad_s[window]
         return (wheel - ratio * flywheel)[::5]
 
     def residual(theta: np.ndarray, chosen: Sequence[int]) -> np.ndarray:
         trial = p.replace(dict(zip(keys, theta * start, strict=True)), "identify")
-        return np.concatenate([weights[i] * slip_error(runs[i], windows[i], trial)
-                               for i in chosen])
+        ratio = trial.number("flywheel.radius_m") / trial.number("wheel.unloaded_radius_m")
+        simulated = simulate_all([runs[i] for i in chosen], trial)
+        return np.concatenate([weights[i] * slip_error(runs[i], sim, windows[i], ratio)
+                               for i, sim in zip(chosen, simulated, strict=True)])
 
     fit = least_squares(lambda th: residual(th, range(len(runs))), np.ones(3), diff_step=1e-4,
                         bounds=REFINE_BOUNDS, max_nfev=REFINE_ITERATIONS)

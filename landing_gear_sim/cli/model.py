@@ -208,6 +208,10 @@ def cmd_rig(args: argparse.Namespace) -> int:
                 else "stopped before anything was recorded")
         print(f"{PROG}: interrupted; {held}", file=sys.stderr)
         return 130
+    if outcome.failed is not None:
+        print(f"{PROG}: error: the run failed ({outcome.failed} exit code "
+              f"{outcome.exit_codes[outcome.failed]})", file=sys.stderr)
+        return 1
     if not outcome.ok:
         code = outcome.exit_codes.get("plant")
         why = {LOST_PEER_EXIT: "; a lost node's input was held, see above",

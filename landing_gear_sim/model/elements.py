@@ -131,6 +131,15 @@ def rolling_radius(p, vertical_load_n):
     return p[R0] - (p[RADIUS_A] * fz * fz + p[RADIUS_B] * fz + p[RADIUS_C])
 
 
+@njit(cache=True)
+def rolling_radii(p, vertical_load_n):
+    """:func:`rolling_radius` of each load of an array (n,) [m]."""
+    out = np.empty(vertical_load_n.shape[0])
+    for i in range(out.shape[0]):
+        out[i] = rolling_radius(p, vertical_load_n[i])
+    return out
+
+
 @njit(cache=True, inline="always")
 def slip_ratio(hub_speed_m_s, wheel_speed_rad_s, radius_m):
     """Longitudinal slip λ = (v_h − ω r)/v_h, eq. (1); v_h floored at MIN_HUB_SPEED_M_S."""

@@ -33,7 +33,7 @@ from msg_tools.run import Run
 STOP_REASONS = ("end of input", "stop speed reached")
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)  # runs simulate side by side on threads
 def run_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed, angle, out):
     """Simulate one run; fill ``out`` (n, N_CHANNELS); return (rows written, stop code).
     ``angle``: the wheel's measured angle at each step (n,), which the plant's angle takes

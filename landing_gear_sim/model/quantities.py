@@ -23,8 +23,8 @@ PEAK_GRID = np.linspace(0.0, 1.0, 20001)  # slip grid on which the friction peak
 def rolling_radius_at(params: RigParameters, load_n: np.ndarray) -> np.ndarray:
     """Rolling radius of eq. (9) at each vertical load [N] → [m], same shape; r0 when the
     ``load_dependent_radius`` element is off. The compiled law itself, once per sample."""
-    vector = params.vector()
-    return np.array([el.rolling_radius(vector, f) for f in np.asarray(load_n, dtype=float)])
+    load = np.asarray(load_n, dtype=float)
+    return el.rolling_radii(params.vector(), load.ravel()).reshape(load.shape)
 
 
 def friction_at(params: RigParameters, slip: np.ndarray) -> np.ndarray:

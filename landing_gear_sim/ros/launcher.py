@@ -59,14 +59,17 @@ def node_command(node: NodeSpec, params_file: Path, python: str = sys.executable
 
 @dataclass
 class Outcome:
-    """How a graph run ended: exit code per node, and whether the user interrupted it."""
+    """How a graph run ended: exit code per node, whether the user interrupted it, and the
+    node whose death ended it."""
 
     exit_codes: dict[str, int]
     interrupted: bool = False
+    failed: str | None = None
 
     @property
     def ok(self) -> bool:
-        return not self.interrupted and self.exit_codes.get("plant") == 0
+        return (not self.interrupted and self.failed is None
+                and self.exit_codes.get("plant") == 0)
 
 
 def run_graph(options: GraphOptions, params: RigParameters,
@@ -87,6 +90,7 @@ def _run_processes(options: GraphOptions, params_file: Path,
     say(f"starting {', '.join(n.name for n in nodes)} (ROS_DOMAIN_ID {domain}, discovery "
         f"{discovery})")
     processes: dict[str, subprocess.Popen] = {}
+    failed = None
     # SIGINT too: a shell starts a background job with SIGINT ignored, and the nodes would
     # stop on the terminal's Ctrl-C while the launcher reported a complete run
     stop = StopRequest()
@@ -97,13 +101,14 @@ def _run_processes(options: GraphOptions, params_file: Path,
                 break
             processes[node.name] = subprocess.Popen(node_command(node, params_file), env=env,
                                                     preexec_fn=_node_process)
-        _wait_for_plant(processes, say, stop)
-        _wait_all(processes, LINGER_S, stop)
+        failed = _wait_for_plant(processes, say, stop)
+        if failed is None:
+            _wait_all(processes, LINGER_S, stop)
     finally:
         _stop(processes)  # a second Ctrl-C meanwhile is only noted: the bag is being closed
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-    return Outcome(_codes(processes), stop.requested)
+    return Outcome(_codes(processes), stop.requested, failed)
 
 
 class StopRequest:
@@ -135,19 +140,19 @@ def _node_process() -> None:
 
 
 def _wait_for_plant(processes: dict[str, subprocess.Popen], say: Callable[[str], None],
-                    stop: StopRequest) -> None:
-    reported: set[str] = set()
+                    stop: StopRequest) -> str | None:
+    """Wait until the plant ends the run; the name of a node that died before, which
+    ends it at once (a run with a participant missing is not the run that was asked)."""
     while not stop.requested and processes["plant"].poll() is None:
         for name, process in processes.items():
             code = process.poll()
-            if code is None or name in reported:
-                continue
-            reported.add(name)
             if code == 2:  # a configuration error: the run cannot start
                 raise GraphError(f"node {name} refused its configuration (see above)")
-            if code != 0:
-                say(f"node {name} died (exit code {code}); the plant holds its input")
+            if code is not None and code != 0:
+                say(f"node {name} died (exit code {code}): the run failed; stopping the graph")
+                return name
         time.sleep(0.05)
+    return None
 
 
 def _wait_all(processes: dict[str, subprocess.Popen], timeout_s: float,
@@ -167,6 +172,7 @@ def _stop(processes: dict[str, subprocess.Popen]) -> None:
         for process in processes.values():
             if process.poll() is None:
                 process.send_signal(signal.SIGINT)
+                process.send_signal(signal.SIGCONT)  # a stopped node acts on it only so
         _wait_all(processes, min(RESEND_S, deadline - time.monotonic()))
     for process in processes.values():
         if process.poll() is None:

@@ -8,9 +8,15 @@ Importing a node takes seconds (numpy, numba, rclpy). A Ctrl-C or SIGTERM in tha
 KeyboardInterrupt traceback and −2, or an ImportError when it hit numpy's import. So the
 signals are only noted here; once rclpy has installed its own handlers,
 :func:`~landing_gear_sim.ros.nodes.common.run_node` stops cleanly if one came.
+
+A node also ends when whoever started it is gone: a supervisor's SIGTERM ends ``ros2
+launch`` in milliseconds and launch does not take its nodes along, which then ran on as
+orphans and mixed into the next run on the same domain.
 """
 
 import signal
+
+from landing_gear_sim.processes import die_with_parent
 
 _received: list[int] = []
 
@@ -26,3 +32,4 @@ def stop_requested() -> bool:
 
 signal.signal(signal.SIGINT, _note)
 signal.signal(signal.SIGTERM, _note)
+die_with_parent()  # the parent's death comes as a SIGTERM: a stop request like any other

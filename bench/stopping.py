@@ -1,0 +1,151 @@
+"""Stopping benchmark: how fast and how cleanly the graph ends on each signal path.
+
+Run: ``python bench/stopping.py [--trials 20] [--workspace WS]``. Each path is a signal
+(SIGINT, SIGTERM) sent to a lone node (``plant``, ``recorder``), to ``landing-gear-sim rig``
+(its PID; its whole process group, as a terminal's Ctrl-C) and, with ``--workspace`` (a
+colcon-built workspace and ``ros2`` on PATH, see ../shared/tools/rosenv-recipe.sh), to
+``ros2 launch`` (its PID, its process group). Per path: the stop time (median and max,
+signal to exit), the exit codes, and the trials that were not clean: a traceback, a node
+escalated to SIGTERM/SIGKILL, or a process left running. Issue 31's target: every node
+down within 1 s, 20/20 clean. The reference measured in the same run: a bare rclpy node
+(init, a node, spin) stopped the same way.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import os
+import re
+import signal
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"  # DDS never leaves this machine
+os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
+
+TARGET_S = 1.0
+SIGNALS = {"SIGINT": signal.SIGINT, "SIGTERM": signal.SIGTERM}
+BARE_NODE = ("import rclpy, sys\nfrom rclpy.executors import ExternalShutdownException\n"
+             "rclpy.init(); node = rclpy.create_node('bare')\n"
+             "print('running', file=sys.stderr, flush=True)\n"
+             "try:\n    rclpy.spin(node)\n"
+             "except (KeyboardInterrupt, ExternalShutdownException):\n    pass\n")
+LONG_RUN = ["--profile", "constant", "--pressure-bar", "0", "--set",
+            "rig_test.max_duration_s=600"]
+ESCALATED = re.compile(r"escalating|exit codes: .*-(9|15)\b|process has died")
+
+
+@dataclass(frozen=True)
+class Trial:
+    seconds: float
+    code: int
+    traceback: bool
+    escalated: bool
+    orphan: bool
+
+    @property
+    def clean(self) -> bool:
+        return not (self.traceback or self.escalated or self.orphan)
+
+
+def _session_alive(session: int) -> bool:
+    return subprocess.run(["pgrep", "-s", str(session)], capture_output=True).returncode == 0
+
+
+def trial(command: list[str], ready: str, sig: int, group: bool) -> Trial:
+    """Start ``command`` in a session of its own, wait for ``ready`` in its output, signal
+    it (or its group), time the exit; whatever it left running is killed afterwards."""
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                               text=True, start_new_session=True)
+    assert process.stdout is not None
+    lines: list[str] = []
+    started = threading.Event()
+
+    def read() -> None:
+        for line in process.stdout:
+            lines.append(line)
+            if ready in line:
+                started.set()
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    try:
+        if not started.wait(180):
+            raise RuntimeError(f"{command[:4]} never said {ready!r}: {''.join(lines)[-1500:]}")
+        begun = time.monotonic()
+        (os.killpg if group else os.kill)(process.pid, sig)
+        code = process.wait(timeout=120)
+        seconds = time.monotonic() - begun
+        reader.join(10)
+        time.sleep(0.5)  # a node that outlives its launcher shows up here
+        orphan = _session_alive(process.pid)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(process.pid, signal.SIGKILL)
+    output = "".join(lines)
+    return Trial(seconds, code, "Traceback" in output, bool(ESCALATED.search(output)), orphan)
+
+
+def _row(name: str, trials: list[Trial], reference_s: float | None) -> None:
+    times = [t.seconds for t in trials]
+    median = statistics.median(times)
+    codes = ",".join(sorted({str(t.code) for t in trials}))
+    ratio = f"{median / reference_s:5.1f}x" if reference_s else "    -"
+    print(f"{name:38s} {median:6.2f} s {max(times):6.2f} s {ratio} {TARGET_S / max(times):5.2f}x"
+          f"  {sum(t.clean for t in trials):2d}/{len(trials):<2d}  codes {codes}", flush=True)
+
+
+def paths(folder: Path, workspace: Path | None) -> dict[str, tuple[list[str], str, bool]]:
+    """name → (command, what it prints when up, signal the group)."""
+    python = [sys.executable, "-m"]
+    bag = f"bag:={folder}/{{n}}"
+    found: dict[str, tuple[list[str], str, bool]] = {
+        "bare rclpy node (reference)": ([sys.executable, "-c", BARE_NODE], "running", False),
+        "plant": ([*python, "landing_gear_sim.ros.nodes.plant"], "running", False),
+        "recorder": ([*python, "landing_gear_sim.ros.nodes.recorder", "--ros-args", "-p", bag],
+                     "running", False),
+        "rig (its PID)": ([*python, "landing_gear_sim", "rig", *LONG_RUN, "--bag",
+                           f"{folder}/{{n}}"], "run starts", False),
+        "rig (process group)": ([*python, "landing_gear_sim", "rig", *LONG_RUN, "--bag",
+                                 f"{folder}/{{n}}"], "run starts", True),
+    }
+    if workspace is not None:
+        launch = (f"source {workspace}/install/setup.bash && exec ros2 launch landing_gear_sim "
+                  f"rig.launch.py profile:=constant pressure_bar:=0 {bag}")
+        for name, group in (("ros2 launch (its PID)", False),
+                            ("ros2 launch (process group)", True)):
+            found[name] = (["bash", "-c", launch], "run starts", group)
+    return found
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--trials", type=int, default=20, help="per path and signal")
+    parser.add_argument("--workspace", type=Path, help="colcon workspace for ros2 launch")
+    args = parser.parse_args()
+    print(f"stop time per signal path, {args.trials} trials each (ratio: median against the "
+          f"bare rclpy node; target: {TARGET_S:g} s / max)")
+    print(f"{'path':38s} {'median':>8s} {'max':>8s} {'ratio':>5s} {'target':>6s}  clean")
+    with tempfile.TemporaryDirectory() as folder:
+        count = 0
+        reference: dict[str, float] = {}
+        for name, (command, ready, group) in paths(Path(folder), args.workspace).items():
+            for signal_name, sig in SIGNALS.items():
+                trials = []
+                for _ in range(args.trials):
+                    count += 1
+                    trials.append(trial([c.format(n=count) for c in command], ready, sig, group))
+                if name.startswith("bare"):
+                    reference[signal_name] = statistics.median(t.seconds for t in trials)
+                _row(f"{name} {signal_name}", trials, reference.get(signal_name))
+
+
+if __name__ == "__main__":
+    main()

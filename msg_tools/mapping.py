@@ -8,7 +8,7 @@ optional ``scale`` and ``offset`` applied to the raw number before its unit::
     current_ref_A: {column: I_valve, unit: mA}
     brake_pressure_bar: {column: p_brake, unit: psi, offset: -14.696}
     longitudinal_force_N: {column: Fx, unit: kN, scale: -1}
-    wheel_speed_rad_s: {topic: /wheel/joint_states, field: position[0], unit: rad}
+    wheel_speed_rad_s: {topic: /wheel/joint_states, field: "position[0]", unit: rad}
 
 so that ``SI value = (raw * scale + offset) * unit factor``. Columns the file does not
 mention keep the contract's name and unit. A ``field`` ending in ``position[i]`` (or a
@@ -81,7 +81,10 @@ def read_mapping(path: Path) -> Mapping:
     try:
         document = yaml.safe_load(Path(path).read_text())
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
-        raise RunFormatError(f"{path}: cannot read column mapping ({exc})") from None
+        # brackets open a YAML list inside {…}: the commonest slip in a bag's field
+        hint = ("; quote a field with brackets: field: \"velocity[0]\""
+                if isinstance(exc, yaml.YAMLError) and "[" in Path(path).read_text() else "")
+        raise RunFormatError(f"{path}: cannot read column mapping ({exc}){hint}") from None
     if not isinstance(document, dict):
         raise RunFormatError(f"{path}: a column mapping is 'contract_column: {{column, unit}}'")
     unknown = sorted(set(document) - set(CSV_COLUMNS))

@@ -49,3 +49,27 @@ def test_every_documented_command_line_parses(document, line):
         build_parser().parse_args(_as_argv(line))
     except SystemExit as exc:
         pytest.fail(f"{document}: `{line}` no longer parses (exit {exc.code})")
+
+
+YAML_FENCE = re.compile(r"```yaml\n(.*?)```", re.DOTALL)
+MAPPINGS = [(path.relative_to(ROOT).as_posix(), block) for path in DOCUMENTS
+            for block in YAML_FENCE.findall(path.read_text())
+            if "{column:" in block or "{topic:" in block]
+
+
+def test_the_documents_show_column_mappings():
+    assert len(MAPPINGS) >= 3, MAPPINGS
+
+
+@pytest.mark.parametrize(("document", "block"), MAPPINGS)
+def test_every_documented_column_mapping_reads(document, block, tmp_path):
+    """The data contract once showed `field: velocity[wheel]` unquoted: not valid YAML."""
+    from msg_tools.errors import RunFormatError
+    from msg_tools.mapping import read_mapping
+
+    path = tmp_path / "mapping.yaml"
+    path.write_text(block)
+    try:
+        read_mapping(path)
+    except RunFormatError as exc:
+        pytest.fail(f"{document}: the mapping it shows does not read: {exc}")

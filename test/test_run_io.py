@@ -63,6 +63,14 @@ def test_mapping_with_an_unknown_unit_is_refused(tmp_path):
         read_mapping(tmp_path / "map.yaml")
 
 
+def test_a_bag_field_with_unquoted_brackets_is_refused_with_the_fix(tmp_path):
+    """`field: velocity[wheel]` inside {…} is not YAML (the data contract once showed it)."""
+    (tmp_path / "map.yaml").write_text(
+        "wheel_speed_rad_s: {topic: /joint_states, field: velocity[wheel]}\n")
+    with pytest.raises(RunFormatError, match=r'quote a field with brackets: field: "velocity'):
+        read_mapping(tmp_path / "map.yaml")
+
+
 def test_pressure_in_pa_declared_as_bar_is_caught(tmp_path, run):
     text = format_csv(run).splitlines()
     header = text[0].split(",")

@@ -194,7 +194,8 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     from landing_gear_sim.diagnosis.start import starting_model
 
     check_outputs(files=[args.json, args.output], folders=[args.report])
-    starting_model(params_of(args), args.start_without)  # a misspelt element: at once
+    base = params_of(args)
+    starting_model(base, args.start_without)  # a misspelt element: at once
 
     from landing_gear_sim.diagnosis.diagnose import diagnose
     from landing_gear_sim.report.diagnosis import diagnosis_summary, write_diagnosis_report
@@ -204,7 +205,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     for problem in campaign.problems:
         progress(f"skipped: {problem}")
     started = time.perf_counter()
-    result = diagnose(campaign.runs, params_of(args), args.start_without,
+    result = diagnose(campaign.runs, base, args.start_without,
                       lambda m: progress(f"[{time.perf_counter() - started:5.1f} s] {m}"))
     result.problems[:0] = campaign.problems
     print(diagnosis_summary(result))

@@ -13,13 +13,21 @@ import numpy as np
 import pytest
 
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
+from landing_gear_sim.calibration.identify import identify
 from landing_gear_sim.calibration.logger import Logger
-from landing_gear_sim.calibration.measured import simulate_all
+from landing_gear_sim.calibration.measured import CHANNELS, simulate_all
 from landing_gear_sim.calibration.runs import classify_all
-from landing_gear_sim.diagnosis.catalogue import fade_reach, gear_walk_key_parameters
+from landing_gear_sim.diagnosis.catalogue import (
+    fade_reach,
+    gear_walk_key_parameters,
+    noise_scales,
+)
+from landing_gear_sim.diagnosis.consistency import check_campaign
 from landing_gear_sim.diagnosis.diagnose import diagnose
 from landing_gear_sim.diagnosis.equations import Equation, EquationError, locate
+from landing_gear_sim.diagnosis.families import HIDDEN, Evidence, gain_law
 from landing_gear_sim.diagnosis.findings import Signature, SignatureKind
+from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, score_candidate
 from landing_gear_sim.diagnosis.signatures import find_signatures, unexplained
 from landing_gear_sim.errors import ParameterError
 from msg_tools.io import read_campaign
@@ -222,3 +230,23 @@ def test_a_gear_walk_read_through_a_coarse_encoder_is_named(reference, tmp_path)
                                            for f in result.candidates]
     assert result.findings[0].parameters["frequency_hz"] == pytest.approx(
         gear_walk_key_parameters(rig)["frequency_hz"], rel=0.05)
+
+
+def test_a_discovered_term_never_fits_worse_than_the_model_without_it(reference, tmp_path):
+    """A brake gain rising with pressure read through a 64-line encoder with a 50 ms dropout
+    per run (the law drawn by the test, unseen by the code under test): the term's fit began
+    where the datasheet's gain offset the term's start, stalled at three times the cost of the
+    model without it (ΔBIC +3815, so not accepted) and a drift through the runs was named
+    instead. The term at zero is that model: its fit can end no worse."""
+    _, hidden = HIDDEN["pressure_level"]
+    runs, rig = _campaign(reference, tmp_path, 1272, lambda rng: hidden.draw(rng, reference),
+                          logger=Logger(encoder_counts=64, dropout_s=0.05), names=None)
+    runs = classify_all(runs)
+    calibrated = identify(runs, reference, jackknife=False).params
+    evidence = Evidence(runs, calibrated, check_campaign(runs, calibrated), [])
+    [proposal] = gain_law.FAMILY.propose(evidence)
+    scored = score_candidate(proposal.candidate, runs, calibrated, reference,
+                             noise_scales(runs, CHANNELS), [])
+    assert scored.finding.delta_bic < BIC_THRESHOLD, scored.finding.evidence
+    assert scored.finding.parameters[hidden.key] == pytest.approx(rig.number(hidden.slot),
+                                                                  rel=hidden.tolerance)

@@ -69,6 +69,8 @@ class Candidate:
             within reach.
         family: a discovered term's family (``diagnosis.families``); '' for a catalogue
             cause.
+        neutral: values of ``keys`` at which the extended model is the model without it
+            (a term at zero); empty: no such point within the bounds.
     """
 
     cause: str
@@ -83,6 +85,7 @@ class Candidate:
     contract: tuple[tuple[str, str], ...]
     reach: Reach | None = None
     family: str = ""
+    neutral: tuple[float, ...] = ()
 
 
 Reach = Callable[[dict[str, float], Sequence[ClassifiedRun], RigParameters], str]

@@ -132,9 +132,11 @@ def term_candidate(family: Family, keys: Sequence[str], start: Sequence[float],
     ``free`` on ``runs``, checked on ``held_out`` (none: half the fitting runs), compared on
     ``channels``; contract ``names`` default to the keys' last part."""
     contract = tuple(zip(names or [k.split(".")[1] for k in keys], keys, strict=True))
+    off = all(low <= 0.0 <= high for low, high in bounds)
     return Candidate(cause=DISCOVERED, element=None, keys=tuple(keys), starts=(tuple(start),),
                      bounds=tuple(bounds), free=tuple(free), runs=runs, channels=channels,
-                     held_out=held_out, contract=contract, family=reports or family.reports)
+                     held_out=held_out, contract=contract, family=reports or family.reports,
+                     neutral=(0.0,) * len(keys) if off else ())
 
 
 def sparse_coefficients(x: np.ndarray, y: np.ndarray) -> np.ndarray:

@@ -32,6 +32,7 @@ setup(
         "matplotlib>=3.7",
         "PyYAML>=6.0",
         "rosbags>=0.11",
+        "mcap>=1.1",
         "scikit-learn>=1.3",
         "dask[distributed]>=2024.1",
         "threadpoolctl>=3.1",

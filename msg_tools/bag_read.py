@@ -10,6 +10,7 @@ bag's ``Float64`` current by log time, held as the valve sees it.
 from __future__ import annotations
 
 from array import array
+from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -19,6 +20,7 @@ from rosbags.highlevel import AnyReader
 
 from .bag_fields import Source, resolve
 from .bag_io import TYPESTORE
+from .bag_recover import recovered
 from .checks import check_plausible
 from .contract import CSV_TO_FIELD
 from .derivative import speed_from_angle
@@ -60,26 +62,46 @@ def read_bag(path: Path, name: str | None = None, mapping: Mapping | None = None
     path = Path(path)
     where = str(path)
     try:
-        with AnyReader(bag_paths(path), default_typestore=TYPESTORE) as reader:
+        with recovered(bag_paths(path)) as (paths, notes), \
+                AnyReader(paths, default_typestore=TYPESTORE) as reader:
             types = {c.topic: c.msgtype for c in reader.connections}
             sources = resolve(mapping or DEFAULT_MAPPING, types, where)
-            series = _stream(reader, sources)
+            series, read = _stream(reader, sources)
+            notes += _lost(reader, read)
     except RunFormatError:
         raise
     except Exception as exc:  # rosbags raises several types for damaged bags
         raise RunFormatError(f"{where}: cannot read bag ({exc})") from None
     fields = _on_wheel_base(series, sources, where)
     check_plausible(fields, where)
-    return Run(name=name or path.stem, source=where, notes=(), **fields)
+    return Run(name=name or path.stem, source=where, notes=tuple(notes), **fields)
 
 
-def _stream(reader: AnyReader, sources: list[Source]) -> dict[str, _Series]:
+def _lost(reader: AnyReader, read: Counter[str]) -> list[str]:
+    """Per topic read, the messages the bag's metadata counts that were not in it."""
+    counted: Counter[str] = Counter()
+    for connection in reader.connections:
+        counted[connection.topic] += connection.msgcount
+    short: dict[tuple[int, int], list[str]] = {}
+    for topic in read:
+        if read[topic] < counted[topic]:
+            short.setdefault((read[topic], counted[topic]), []).append(topic)
+    return [f"{', '.join(topics)}: {n} of the {total} messages the bag's metadata counts were "
+            f"in it ({total - n} lost)" for (n, total), topics in short.items()]
+
+
+def _stream(reader: AnyReader, sources: list[Source]) -> tuple[dict[str, _Series],
+                                                                Counter[str]]:
+    """The contract columns of ``sources`` as they stream in, and the messages read per
+    topic."""
     series = {s.contract: _Series() for s in sources}
     by_topic: dict[str, list[Source]] = {}
     for source in sources:
         by_topic.setdefault(source.topic, []).append(source)
     wanted = [c for c in reader.connections if c.topic in by_topic]
+    read: Counter[str] = Counter()
     for connection, log_time, raw in reader.messages(connections=wanted):
+        read[connection.topic] += 1
         message = reader.deserialize(raw, connection.msgtype)
         for source in by_topic[connection.topic]:
             stamp, stamped = _stamp_s(message, log_time)
@@ -93,7 +115,7 @@ def _stream(reader: AnyReader, sources: list[Source]) -> dict[str, _Series]:
             target.values.append(value)
             target.positions |= position
             target.stamped |= stamped
-    return series
+    return series, read
 
 
 def _stamp_s(message: Any, log_time_ns: int) -> tuple[float, bool]:

@@ -45,7 +45,9 @@ PYTHON_KEYS = {"numpy": "python3-numpy", "scipy": "python3-scipy",
 NO_KEY = {"threadpoolctl": "comes with python3-sklearn",
           "dask": "history and montecarlo only; no rosdep key (setup.py brings it)",
           "distributed": "the same", "pyarrow": "the formats extra, read only when asked",
-          "h5py": "the same", "asammdf": "the same", "nptdms": "the same"}
+          "h5py": "the same", "asammdf": "the same", "nptdms": "the same",
+          "mcap": "a cut .mcap recovered; no key of its own (rosdistro, Aug 2026: only "
+                  "mcap-ros2-support); setup.py brings it"}
 OWN = {"landing_gear_sim", "antiskid", "msg_tools"}
 
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 import dataclasses
 import math
 import shutil
+import sqlite3
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -147,6 +149,91 @@ def test_empty_or_truncated_bag_is_an_error_not_a_traceback(tmp_path, run, damag
         database.write_bytes(database.read_bytes()[:2048])
     with pytest.raises(RunFormatError, match="bag"):
         read_run(path)
+
+
+def _killed_recorder(run, tmp_path, journal: str) -> Path:
+    """A sqlite3 bag as a recorder killed mid-write leaves it: copies of its files taken
+    while the writer still held the database open. ``wal``: the second half of the
+    messages committed into a write-ahead log not yet checkpointed; ``rollback``: a
+    transaction deleting that half under way, its pages already in the database file
+    (a small page cache spills them), the hot journal beside it."""
+    source, copy = tmp_path / "recording", tmp_path / "copy"
+    write_bag(run, source, "sqlite3")
+    database = next(source.glob("*.db3"))
+    connection = sqlite3.connect(database, isolation_level=None)
+    middle = "timestamp > (SELECT (MIN(timestamp) + MAX(timestamp)) / 2 FROM messages)"
+    if journal == "wal":
+        rows = connection.execute(f"SELECT * FROM messages WHERE {middle}").fetchall()
+        connection.execute(f"DELETE FROM messages WHERE {middle}")
+        connection.execute("PRAGMA journal_mode=WAL")
+        connection.execute("PRAGMA wal_autocheckpoint=0")
+        connection.executemany("INSERT INTO messages VALUES (?, ?, ?, ?)", rows)
+    else:
+        connection.execute("PRAGMA cache_size=1")
+        connection.execute("BEGIN")
+        connection.execute(f"DELETE FROM messages WHERE {middle}")
+    shutil.copytree(source, copy)
+    connection.close()
+    return copy
+
+
+def test_a_bag_whose_messages_sit_in_its_write_ahead_log_is_read_whole(tmp_path, run):
+    """A sqlite3 bag's last messages in an un-checkpointed `-wal` were read as a run of
+    half the length, exit 0 (rosbags opens the database immutable and never sees the
+    log). sqlite applies the log when it opens the database; done on a copy, the user's
+    files stay as they were."""
+    bag = _killed_recorder(run, tmp_path, "wal")
+    files = {p.name: p.read_bytes() for p in bag.iterdir()}
+    recovered = read_run(bag)
+    assert len(recovered) == len(run)
+    assert any("write-ahead log" in note for note in recovered.notes), recovered.notes
+    assert {p.name: p.read_bytes() for p in bag.iterdir()} == files
+
+
+def test_a_bag_with_a_hot_journal_is_rolled_back_not_refused(tmp_path, run):
+    """A recorder killed inside a transaction leaves a hot `-journal`: the database file
+    read as it lies was 'malformed'. Rolled back as sqlite does, the run is what was
+    committed."""
+    recovered = read_run(_killed_recorder(run, tmp_path, "rollback"))
+    assert len(recovered) == len(run)
+    assert any("unfinished transaction" in note for note in recovered.notes), recovered.notes
+
+
+def test_a_bag_that_lost_messages_says_how_many_of_those_its_metadata_counts(tmp_path, run):
+    """metadata.yaml counts every message the recorder wrote; a storage file that holds
+    fewer (cut, or restored from an older copy) was read as a shorter run, exit 0."""
+    path = tmp_path / "bag"
+    write_bag(run, path, "sqlite3")
+    with sqlite3.connect(next(path.glob("*.db3"))) as connection:
+        connection.execute("DELETE FROM messages WHERE timestamp > "
+                           "(SELECT MIN(timestamp) + 2000000000 FROM messages)")
+    recovered = read_run(path)
+    assert len(recovered) < len(run)
+    lost = len(run) - len(recovered)
+    assert any(f"{len(recovered)} of the {len(run)} messages" in note and f"{lost} lost" in note
+               for note in recovered.notes), recovered.notes
+
+
+@pytest.mark.parametrize("kept", [0.6, 0.95])
+def test_an_mcap_cut_short_gives_every_complete_message_and_says_what_was_lost(tmp_path, run,
+                                                                              kept):
+    """A recorder killed mid-write leaves an mcap without its footer: 'File end magic is
+    invalid', nothing read, even at 95 % of the file. Every complete message is read (of
+    the chunk cut through as well), the run is what they hold, and the note says how many
+    of the messages metadata.yaml counts were lost."""
+    path = tmp_path / "bag"
+    write_bag(run, path, "mcap")
+    storage = next(path.glob("*.mcap"))
+    whole = storage.read_bytes()
+    storage.write_bytes(whole[:int(kept * len(whole))])
+    recovered = read_run(path)
+    # the file ends with its index: a cut at 60 % keeps more than 60 % of the messages
+    assert 0.9 * kept * len(run) < len(recovered) < len(run)
+    np.testing.assert_allclose(recovered.time_s, run.time_s[:len(recovered)], atol=1e-9)
+    assert any("cut short" in note for note in recovered.notes), recovered.notes
+    assert any(f"{len(recovered)} of the {len(run)} messages" in note and "lost" in note
+               for note in recovered.notes), recovered.notes
+    assert storage.read_bytes() == whole[:int(kept * len(whole))]
 
 
 def test_campaign_skips_a_bad_file_and_keeps_the_rest(tmp_path, csv_file):

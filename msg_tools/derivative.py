@@ -10,7 +10,6 @@ about a tenth of the sample rate (99 Hz at 1 kHz), above the wheel dynamics of i
 from __future__ import annotations
 
 import numpy as np
-import scipy.signal
 
 WINDOW_SAMPLES = 11
 ORDER = 2
@@ -22,4 +21,8 @@ def speed_from_angle(time_s: np.ndarray, angle_rad: np.ndarray) -> np.ndarray:
     speed = np.gradient(unwrapped, time_s)
     if speed.size <= WINDOW_SAMPLES:
         return speed
+    # imported here: scipy.signal costs ~1.6 s to import, paid by every ROS node that reads
+    # or writes bags (through msg_tools.io) and never meets an angle-only log
+    import scipy.signal
+
     return scipy.signal.savgol_filter(speed, WINDOW_SAMPLES, ORDER)

@@ -2,15 +2,18 @@
 
 A speed logged in rpm but declared rad/s, or a pressure in psi declared as bar, stays
 within any physical range; but before braking the wheel rolls freely on the flywheel (equal
-rim speeds), and the valve's pressure follows its current through the datasheet map within
-tens of percent. A ratio far from 1 that matches a unit factor names the unit.
+rim speeds), the valve's pressure follows its current through the datasheet map within
+tens of percent, and over a stop the flywheel loses the momentum the load cell's force (and
+the drag) takes from it. A ratio far from 1 that matches a unit factor names the unit.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
+from scipy.integrate import trapezoid
 
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.errors import IdentificationError
@@ -30,6 +33,7 @@ def check_units(runs: Sequence[ClassifiedRun], params: RigParameters) -> None:
     for run in runs:
         _check_speeds(run, params)
         _check_pressure(run, params)
+        _check_momentum(run, params)
 
 
 def _likely(ratio: float, quantity: str, contract_unit: str) -> str | None:
@@ -41,9 +45,10 @@ def _likely(ratio: float, quantity: str, contract_unit: str) -> str | None:
     return None
 
 
-def _refuse(run: ClassifiedRun, column: str, ratio: float, what: str, unit: str | None) -> None:
-    hint = f"; it looks like {unit}: declare the unit (units row, header '[{unit}]' or a " \
-           "column mapping)" if unit else "; check its unit and the rig parameters"
+def _refuse(run: ClassifiedRun, column: str, ratio: float, what: str, unit: str | None,
+            also: str = "") -> None:
+    hint = f"; it looks like {unit}{also}: declare the unit (units row, header '[{unit}]' " \
+           "or a column mapping)" if unit else "; check its unit and the rig parameters"
     raise IdentificationError(f"{run.source or run.name}: {column} is {ratio:.3g} times "
                               f"{what}{hint}")
 
@@ -76,3 +81,32 @@ def _check_pressure(run: ClassifiedRun, params: RigParameters) -> None:
     if not PLAUSIBLE_RATIO[0] <= ratio <= PLAUSIBLE_RATIO[1]:
         _refuse(run, "brake_pressure_bar", ratio, "what the valve map gives for its current",
                 _likely(ratio, "pressure", "bar"))
+
+
+EDGE_SAMPLES = 20  # a speed at a stop's start or end: the mean of this many samples
+
+
+def _check_momentum(run: ClassifiedRun, params: RigParameters) -> None:
+    """The flywheel's momentum lost while the wheel is on it, J_f/R_f·Δω_f, against the
+    impulse of the load cell's force, ∫F_x dt. Both speeds in rpm pass the free-rolling
+    check (they agree); this one names them. The drag (a few percent of the force) is left
+    out: it grows with the speed squared, so a speed in the wrong unit would swell it."""
+    on = np.flatnonzero((run.time_s >= run.brake_start_s) & (run.vertical_load_n > CONTACT_LOAD_N)
+                        & (np.abs(run.flywheel_speed_rad_s) > TURNING_RAD_S))
+    if not run.braking or on.size < MIN_BRAKING_SAMPLES:
+        return
+    span = slice(on[0], on[-1] + 1)
+    omega = run.flywheel_speed_rad_s[span]
+    momentum = params.number("flywheel.inertia_kg_m2") / params.number("flywheel.radius_m") \
+        * (np.mean(omega[:EDGE_SAMPLES]) - np.mean(omega[-EDGE_SAMPLES:]))
+    impulse = float(trapezoid(run.longitudinal_force_n[span], run.time_s[span]))
+    ratio = abs(float(momentum) / impulse) if impulse else math.inf
+    if PLAUSIBLE_RATIO[0] <= ratio <= PLAUSIBLE_RATIO[1]:
+        return
+    speed_unit, force_unit = _likely(ratio, "speed", "rad/s"), _likely(1 / ratio, "force", "N")
+    if force_unit and not speed_unit:
+        _refuse(run, "longitudinal_force_N", 1 / ratio, "what the flywheel's momentum lost "
+                "over the stop gives", force_unit)
+    _refuse(run, "flywheel_speed_rad_s", ratio, "what the load cell's force takes from it over "
+            "the stop", speed_unit, also=", and wheel_speed_rad_s too (the two agree while "
+            "rolling freely)")

@@ -26,16 +26,18 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 from mcap.exceptions import McapError
+from mcap.opcode import Opcode
 from mcap.records import Channel, Chunk, Header, McapRecord, Message, Schema
 from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.writer import CompressionType, Writer
 
 JOURNALS = {"-wal": "applied its write-ahead log",
             "-journal": "rolled back an unfinished transaction"}
-
-
 MAGIC = b"\x89MCAP0\r\n"
-_CHUNK_HEAD = struct.Struct("<QQQI")  # message start and end time, uncompressed size, crc
+# a chunk record: opcode (1 byte) and length (8), then message start and end time,
+# uncompressed size, crc, the compression's name (length-prefixed), the records' length
+_RECORD_HEAD = struct.Struct("<BQ")
+_CHUNK_HEAD = struct.Struct("<QQQI")
 
 
 def _storage(path: Path, suffix: str) -> list[Path]:
@@ -116,17 +118,14 @@ def _messages(uri: str) -> int | None:
 
 def _recover_mcap(original: Path, copy: Path) -> str:
     """Rewrite ``copy`` (of the cut ``original``) with every complete message it holds."""
-    records, lost = _records(original.read_bytes())
     with copy.open("wb") as stream:
-        count = _rewrite(records, stream)
-    cut = f", the {lost} bytes after them cut off" if lost else ""
-    return (f"{original.name}: cut short (no footer); {count} complete messages "
-            f"recovered{cut}")
+        count = _rewrite(_records(original.read_bytes()), stream)
+    return f"{original.name}: cut short (no footer); {count} complete messages recovered"
 
 
-def _records(data: bytes) -> tuple[list[McapRecord], int]:
-    """The records of a cut mcap file ``data`` as far as they are complete (the records of
-    complete chunks, and of an uncompressed chunk cut through), and the bytes left over."""
+def _records(data: bytes) -> list[McapRecord]:
+    """The records of a cut mcap file ``data`` as far as they are complete: those of
+    complete chunks, and of an uncompressed chunk cut through."""
     stream = io.BytesIO(data)
     records: list[McapRecord] = []
     end = len(MAGIC)
@@ -135,24 +134,20 @@ def _records(data: bytes) -> tuple[list[McapRecord], int]:
             records.extend(breakup_chunk(record) if isinstance(record, Chunk) else [record])
             end = stream.tell()
     except (McapError, EOFError, struct.error, ValueError):
-        partial = _partial_chunk(data[end:])
-        records.extend(partial)
-        return records, len(data) - end if not partial else 0
-    return records, 0
+        records.extend(_partial_chunk(data[end:]))
+    return records
 
 
 def _partial_chunk(data: bytes) -> list[McapRecord]:
     """The complete records at the start of a chunk record cut through (none if the chunk
     is compressed: its records cannot be read before its end)."""
-    if len(data) < 9 or data[0] != 0x06:  # 0x06: the chunk opcode
+    at = _RECORD_HEAD.size + _CHUNK_HEAD.size
+    if len(data) < at + 4 or data[0] != Opcode.CHUNK:
         return []
-    at = 9 + _CHUNK_HEAD.size
-    if len(data) < at + 4:
+    (name_length,) = struct.unpack_from("<I", data, at)
+    if name_length:  # a compression's name: zstd, lz4
         return []
-    (length,) = struct.unpack_from("<I", data, at)
-    if length:  # a compression name: zstd, lz4
-        return []
-    inner = io.BytesIO(data[at + 4 + 8:])
+    inner = io.BytesIO(data[at + 4 + 8:])  # after the empty name and the records' length
     out: list[McapRecord] = []
     with contextlib.suppress(McapError, EOFError, struct.error, ValueError):
         for record in StreamReader(inner, skip_magic=True).records:

@@ -3,8 +3,8 @@
 A speed logged in rpm but declared rad/s, or a pressure in psi declared as bar, stays
 within any physical range; but before braking the wheel rolls freely on the flywheel (equal
 rim speeds), the valve's pressure follows its current through the datasheet map within
-tens of percent, and over a stop the flywheel loses the momentum the load cell's force (and
-the drag) takes from it. A ratio far from 1 that matches a unit factor names the unit.
+tens of percent, and over a stop the flywheel loses the momentum the load cell's force
+takes from it. A ratio far from 1 that matches a unit factor names the unit.
 """
 
 from __future__ import annotations

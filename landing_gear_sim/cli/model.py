@@ -65,6 +65,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                      "before giving up with an error; 0: wait forever")
     rig.add_argument("--safe-pressure-bar", type=float, default=0.0,
                      help="brake pressure applied once the actuator is lost (default 0)")
+    rig.add_argument("--progress", type=float, default=5.0, metavar="S",
+                     help="say how far the run is every S seconds (default 5; 0: never)")
     rig.add_argument("--namespace", default="rig",
                      help="namespace of the nodes and topics (default rig; a second rig: rig2)")
     rig.add_argument("--no-parameter-services", dest="parameter_services",
@@ -190,7 +192,7 @@ def cmd_rig(args: argparse.Namespace) -> int:
                            safe_pressure_pa=args.safe_pressure_bar * PA_PER_BAR,
                            replay=args.replay is not None, controller=args.controller,
                            parameter_services=args.parameter_services,
-                           namespace=args.namespace.strip("/"))
+                           namespace=args.namespace.strip("/"), progress_s=args.progress)
     source = {None: scenario.name, "external": "your controller"}.get(
         args.controller, f"the {args.controller} controller")  # not "external: ..." (issue 32)
     progress(f"{source} in the {args.clock} graph, up to {scenario.duration_s:.1f} s at "

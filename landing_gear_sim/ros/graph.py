@@ -91,6 +91,8 @@ class GraphOptions:
         start_timeout_s: how long the plant waits for the run to be able to start (every
             participant linked) before giving up with an error; 0: forever.
         safe_pressure_pa: brake pressure the plant applies when the actuator is lost.
+        progress_s: the plant says how far the run is every this many seconds of wall
+            time; 0: never.
         controller: anti-skid controller node to run instead of the profile node, or
             ``external``: none, the commands come from a node started by the user (the
             plant waits for it, see nodes/plant.py).
@@ -111,6 +113,7 @@ class GraphOptions:
     timeout_s: float = 10.0  # long: a starved (not dead) node must not be declared lost
     start_timeout_s: float = 60.0
     safe_pressure_pa: float = 0.0
+    progress_s: float = 5.0
     controller: str | None = None
     replay: bool = False
     parameter_services: bool = True
@@ -128,6 +131,8 @@ class GraphOptions:
             raise GraphError("the lockstep timeout must be > 0 s")
         if not (math.isfinite(self.start_timeout_s) and self.start_timeout_s >= 0):
             raise GraphError("the start timeout must be >= 0 s (0: wait forever)")
+        if not (math.isfinite(self.progress_s) and self.progress_s >= 0):
+            raise GraphError("the progress period must be >= 0 s (0: never)")
         if self.replay and self.run.profile != "file":
             raise GraphError("a replay graph needs the run file (profile 'file')")
 
@@ -143,6 +148,7 @@ LAUNCH_ARGUMENTS: dict[str, tuple[str, str]] = {
     "controller": ("", "anti-skid controller instead of the profile: threshold | slip | "
                    "external (your own node publishes the commands)"),
     "namespace": (NAMESPACE, "namespace of the rig's nodes and topics (a second rig: rig2)"),
+    "progress_s": ("5", "the plant says how far the run is every this many seconds; 0: never"),
 }
 """Launch-file arguments: name -> (default, description)."""
 
@@ -171,17 +177,20 @@ def options_from_arguments(values: dict[str, str]) -> tuple[GraphOptions, Path]:
     def value(name: str) -> str:
         return values.get(name, LAUNCH_ARGUMENTS[name][0])
 
-    try:
-        pressure_pa = float(value("pressure_bar")) * PA_PER_BAR
-    except ValueError:
-        raise GraphError(
-            f"pressure_bar must be a number, got {value('pressure_bar')!r}") from None
+    def number(name: str) -> float:
+        try:
+            return float(value(name))
+        except ValueError:
+            raise GraphError(f"{name} must be a number, got {value(name)!r}") from None
+
+    pressure_pa = number("pressure_bar") * PA_PER_BAR
     controller = value("controller") or None
     run = controlled_run(RunSpec(profile=value("profile"), file=value("file"),
                                  pressure_pa=pressure_pa), controller)
     options = GraphOptions(run=run, clock=value("clock"), storage=value("storage"),
                            bag=Path(value("bag")) if value("bag") else None,
-                           controller=controller, namespace=value("namespace").strip("/"))
+                           controller=controller, namespace=value("namespace").strip("/"),
+                           progress_s=number("progress_s"))
     return options, Path(value("params_file") or default_config_files()[0])
 
 
@@ -203,7 +212,8 @@ def describe(options: GraphOptions) -> list[NodeSpec]:
         NodeSpec("plant", {**run, **shared, "sensor_noise": options.sensor_noise,
                            "timeout_s": options.timeout_s,
                            "start_timeout_s": options.start_timeout_s,
-                           "safe_pressure_pa": options.safe_pressure_pa},
+                           "safe_pressure_pa": options.safe_pressure_pa,
+                           "progress_period_s": options.progress_s},
                  (*SENSOR_TOPICS, TOPIC_CLOCK, TOPIC_RUN_END), (TOPIC_HYDRAULIC, TOPIC_LOAD)),
         NodeSpec("actuator", {**run, **shared}, (TOPIC_HYDRAULIC,), (TOPIC_CURRENT,)),
         NodeSpec("loading_device", {**run, **shared}, (TOPIC_LOAD,), (TOPIC_FLYWHEEL,)),

@@ -77,6 +77,9 @@ class PlantNode(GraphNode):
         self._start_timeout_s = float(declare(
             self, "start_timeout_s", 60.0, "give up (exit 4) when the run could not start "
             "in this long [s]; 0: wait forever"))
+        self._progress_s = float(declare(self, "progress_period_s", 5.0,
+                                         "say how far the run is every this many seconds of "
+                                         "wall time [s]; 0: never"))
         self._priority = int(declare(self, "realtime_priority", 10,
                                      "real time: SCHED_FIFO priority of the stepping thread "
                                      "(1-99; 0: leave the scheduling alone)"))
@@ -103,7 +106,7 @@ class PlantNode(GraphNode):
         self.subscription(String, TOPIC_READY, self._on_ready, LATCHED_QOS)
         self._handshake = Handshake(self, self._out, inputs, self._on_linked)
         self._created = self._last_progress = time.monotonic()
-        self._wall_start = 0.0
+        self._wall_start = self._reported = 0.0
         self._published_at: list[float] = []  # real time: wall time of each step's sample
         self._lateness: list[float] = []  # real time: wake-up after the tick's time [s]
         self._busy: list[float] = []  # real time: time spent in a tick [s]
@@ -127,7 +130,7 @@ class PlantNode(GraphNode):
                 or outside_gaps(self, self._out)):
             return
         self._started = True
-        self._wall_start = self._last_progress = time.monotonic()
+        self._wall_start = self._last_progress = self._reported = time.monotonic()
         if not self._lockstep:  # stamps are ROS time from here on
             self._run_clock.origin_ns = self.get_clock().now().nanoseconds
         self.get_logger().info("all links matched: run starts")
@@ -203,7 +206,18 @@ class PlantNode(GraphNode):
     def _step(self, pressure_pa: float, load_n: float) -> None:
         self._plant.advance(pressure_pa, load_n)
         self._last_progress = time.monotonic()
+        if 0 < self._progress_s <= self._last_progress - self._reported:
+            self._report_progress()
         self._publish(self._plant.sample())
+
+    def _report_progress(self) -> None:
+        """How far the run is, in sim time and against the wall clock (a long lockstep
+        run under load once printed nothing for a minute)."""
+        self._reported = self._last_progress
+        sim, most = (n / self._rate_hz for n in (self._plant.step_index, self._plant.n_steps))
+        factor = sim / max(self._reported - self._wall_start, 1e-9)
+        self.get_logger().info(f"sim {sim:.2f} s of up to {most:.2f} s "
+                               f"({100 * sim / most:.0f} %), real-time factor {factor:.2f}")
 
     def _publish(self, sample: SensorSample) -> None:
         stamp = self._run_clock.stamp(sample.step)

@@ -87,14 +87,16 @@ def _run_processes(options: GraphOptions, params_file: Path,
     nodes = describe(options)
     domain = env.get("ROS_DOMAIN_ID", "unset: 0")
     discovery = env.get("ROS_AUTOMATIC_DISCOVERY_RANGE", "unset: SUBNET")
-    say(f"starting {', '.join(n.name for n in nodes)} (ROS_DOMAIN_ID {domain}, discovery "
-        f"{discovery})")
     processes: dict[str, subprocess.Popen] = {}
     failed = None
     # SIGINT too: a shell starts a background job with SIGINT ignored, and the nodes would
-    # stop on the terminal's Ctrl-C while the launcher reported a complete run
+    # stop on the terminal's Ctrl-C while the launcher reported a complete run. Taken before
+    # the first line: a signal sent on seeing "starting" found SIGINT still ignored there
+    # and the whole run went on (exit 0)
     stop = StopRequest()
     previous = {sig: signal.signal(sig, stop) for sig in STOP_SIGNALS}
+    say(f"starting {', '.join(n.name for n in nodes)} (ROS_DOMAIN_ID {domain}, discovery "
+        f"{discovery})")
     try:
         for node in nodes:
             if stop.requested:

@@ -44,7 +44,8 @@ def test_lockstep_graph_equals_offline_and_gives_the_same_bag_every_time(tmp_pat
         assert done.returncode == 0, done.stderr[-3000:]
     said = [float(s) for s in re.findall(r"sim (\d+\.\d+) s of up to 1\.50 s \(\d+ %\)",
                                          done.stderr)]
-    assert said and said == sorted(said) and said[-1] < 1.5, done.stderr[-3000:]
+    # a tick may fall on the last step (100 %) on a slow machine
+    assert said and said == sorted(said) and said[-1] <= 1.5, done.stderr[-3000:]
     files = [sorted(p.relative_to(bag) for p in bag.iterdir()) for bag in bags]
     assert files[0] == files[1]
     for name in files[0]:

@@ -70,7 +70,11 @@ class ReplayNode(GraphNode):
         self._wall_start = 0.0
         self.get_logger().info(f"replaying {path}: {len(self._run)} samples, "
                                f"{self._run.time_s[-1] - self._run.time_s[0]:.2f} s")
-        Handshake(self, self._out, [], self._start, dict.fromkeys(self._out, readers))
+        # the readers hear the run's end too: it is latched only while this node lives, and
+        # a recorder that matched it after the replay had left waited forever (under load)
+        ends = {TOPIC_RUN_END: readers + 1} if readers else {}  # + 1: its own subscription
+        Handshake(self, {**self._out, TOPIC_RUN_END: self._end}, [], self._start,
+                  dict.fromkeys(self._out, readers) | ends)
 
     def _start(self) -> None:
         self._wall_start = time.monotonic()

@@ -21,7 +21,7 @@ import numpy as np
 
 from landing_gear_sim.errors import ParameterError
 from landing_gear_sim.model.integrate import SimulationResult
-from landing_gear_sim.model.sensors import wheel_angle_rad
+from landing_gear_sim.model.sensors import SensorModel, wheel_angle_rad
 from msg_tools.run import SIGNALS, Run
 
 LATE_CHANNELS = tuple(s for s in SIGNALS if s != "current_a")
@@ -103,7 +103,7 @@ class Logger:
         writes it."""
         fields = {name: getattr(run, name) for name in SIGNALS}
         if self.encoder_counts:
-            fields["wheel_speed_rad_s"] = self._counted(run.time_s, result.wheel_speed_rad_s)
+            fields["wheel_speed_rad_s"] = self._counted(run.time_s, _encoder_channel(result))
         fields["current_a"] = self._current(run.current_a, rng)
         if self.late_channel and self.late_s:
             values = fields[self.late_channel]
@@ -112,11 +112,11 @@ class Logger:
         return Run(name=run.name, source=run.source, time_s=run.time_s[kept],
                    **{name: values[kept] for name, values in fields.items()})
 
-    def _counted(self, time_s: np.ndarray, true_rad_s: np.ndarray) -> np.ndarray:
+    def _counted(self, time_s: np.ndarray, read_rad_s: np.ndarray) -> np.ndarray:
         """Encoder lines counted in each sample interval, as a speed [rad/s] (the first
-        sample repeats the second)."""
+        sample repeats the second), of the angle the channel reads."""
         line = 2.0 * np.pi / self.encoder_counts
-        counts = np.floor(wheel_angle_rad(time_s, true_rad_s) / line)
+        counts = np.floor(wheel_angle_rad(time_s, read_rad_s) / line)
         speed = np.diff(counts) * line / np.diff(time_s)
         return np.concatenate([speed[:1], speed])
 
@@ -136,6 +136,13 @@ class Logger:
             start = rng.uniform(first, last)
             kept &= (time_s < start) | (time_s >= start + self.dropout_s)
         return kept
+
+
+def _encoder_channel(result: SimulationResult) -> np.ndarray:
+    """The wheel channel without its noise [rad/s]: a counting encoder has none, but it
+    counts late when the channel is late, and an eccentric disc's lines where the channel
+    ripples."""
+    return SensorModel.of(result.params).wheel_speed(result.time_s, result.wheel_speed_rad_s)
 
 
 def _number(key: str, text: str) -> float:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 
 import numpy as np
@@ -29,6 +30,7 @@ def run_from_table(table: Table, where: str, name: str, mapping: Mapping | None 
     """The run in ``table`` (SI, checked); the message of any error names ``where``."""
     mapping = mapping or DEFAULT_MAPPING
     fields: dict[str, np.ndarray] = {}
+    notes = table.notes
     for contract in CSV_COLUMNS:
         channel = _with_written_unit(_master_time(mapping[contract], contract, table),
                                      contract, table, where)
@@ -36,9 +38,15 @@ def run_from_table(table: Table, where: str, name: str, mapping: Mapping | None 
             found = ", ".join(table.columns) or "none"
             raise RunFormatError(f"{where}: missing column {channel.column} for {contract} "
                                  f"(found {found}); name it in a column-mapping file")
-        fields[CSV_TO_FIELD[contract]] = _to_si(channel, table.columns[channel.column], where)
+        raw = table.columns[channel.column]
+        clock = _clock_seconds(raw) if contract == "time_s" else None
+        if clock is not None:
+            notes += (f"{where}: time column {channel.column} read as a clock time of day "
+                      f"(HH:MM:SS), from {raw[0]}",)
+        fields[CSV_TO_FIELD[contract]] = clock if clock is not None else \
+            _to_si(channel, raw, where)
     check_plausible(fields, where)
-    return Run(name=name, source=where, notes=table.notes, **fields)
+    return Run(name=name, source=where, notes=notes, **fields)
 
 
 def _master_time(channel: Channel, contract: str, table: Table) -> Channel:
@@ -84,11 +92,31 @@ def _to_si(channel: Channel, raw: np.ndarray, where: str) -> np.ndarray:
     return values
 
 
+_CLOCK = re.compile(r"(\d{1,2}):(\d{2}):(\d{2}(?:[.,]\d*)?)")
+DAY_S = 86400.0
+
+
+def _clock_seconds(raw: np.ndarray) -> np.ndarray | None:
+    """Seconds of a time-of-day column (``HH:MM:SS.ffffff``, as loggers without a date
+    stamp), counting on past midnight; None when the column is not one."""
+    if raw.dtype.kind not in "USO" or raw.size == 0 or not _CLOCK.fullmatch(
+            str(raw[0]).strip().strip('"')):
+        return None
+    parts = [_CLOCK.fullmatch(str(value).strip().strip('"')) for value in raw]
+    if not all(parts):
+        return None
+    seconds = np.array([int(h) * 3600 + int(m) * 60 + float(s.replace(",", "."))
+                        for h, m, s in (p.groups() for p in parts if p)])
+    days = np.concatenate([[0], np.cumsum(np.diff(seconds) < -DAY_S / 2)])
+    return seconds + DAY_S * days
+
+
 def _calendar_seconds(channel: Channel, raw: np.ndarray, where: str) -> np.ndarray:
     """Seconds since the epoch of a datetime column (µs resolution)."""
     try:
         stamps = raw.astype("datetime64[us]")
     except ValueError:
-        raise RunFormatError(f"{where}: column {channel.column} holds neither numbers nor "
-                             f"ISO 8601 date-times (first value {raw[0]!r})") from None
+        raise RunFormatError(f"{where}: column {channel.column} holds neither numbers, "
+                             f"clock times (HH:MM:SS) nor ISO 8601 date-times (first value "
+                             f"{str(raw[0])!r})") from None
     return stamps.astype(np.int64) * 1e-6

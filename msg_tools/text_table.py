@@ -3,7 +3,8 @@
 Recognised without configuration: the encoding (UTF-8 with or without BOM, UTF-16 with a
 BOM, else Latin-1), the separator (``,`` ``;`` tab ``|`` or blanks), a decimal comma, a
 metadata preamble above the header, a units row below it or units in the header cells
-(``p_brake [bar]``), quoted cells, text columns (read only when asked for) and a footer.
+(``p_brake [bar]``), quoted cells, thousands separators (``32,412.5``, ``32.412,5``,
+``32'412.5``), text columns (read only when asked for) and a footer.
 The data block is the longest run of lines that split into the same number of cells,
 at least two of them numbers; the header is the last line above it naming the wanted
 columns.
@@ -27,6 +28,10 @@ SEPARATORS = (",", ";", "\t", "|", " ")
 SAMPLE_LINES = 40  # lines of the data block used to decide its separator
 _UNIT_IN_HEADER = re.compile(r"^(.*?)\s*[\[(]([^\])]*)[\])]\s*$")
 _DECIMAL_COMMA = re.compile(r"^[+-]?\d*,\d+([eE][+-]?\d+)?$")
+_BOTH_MARKS = re.compile(r"^[+-]?[\d.,' \u00a0\u202f]*\d$")
+THOUSANDS = {".": ",'\u00a0\u202f ", ",": ".'\u00a0\u202f "}
+"""The marks that may group thousands, by decimal mark (a space only between quotes or
+where blanks do not separate the cells)."""
 
 
 MASTER_TIME = "<master time>"
@@ -92,8 +97,10 @@ def read_table(text: str, wanted: Sequence[str], where: str,
             units.update({n: c.strip() for n, c in zip(names, cells, strict=True) if c.strip()})
     body = lines[first:last]
     numeric = [w for w in wanted if w not in text_columns]
-    columns = dict(zip(numeric, _numbers(body, dialect, names, [bare[w] for w in numeric],
-                                         where, first), strict=True))
+    values, grouped = _numbers(body, dialect, names, [bare[w] for w in numeric], where, first)
+    columns = dict(zip(numeric, values, strict=True))
+    if grouped:
+        notes += (f"{where}: numbers with thousands separators read ({grouped})",)
     for name in wanted:
         if name in text_columns:
             columns[name] = _text(body, dialect, names.index(bare[name]))
@@ -153,15 +160,35 @@ def sniff(lines: list[str], where: str) -> Dialect:
 
 
 def _uses_decimal_comma(rows: list[list[str]]) -> bool:
-    return any(_DECIMAL_COMMA.match(cell.strip()) for row in rows for cell in row)
+    """A number holding both marks decides (the later one is the decimal mark: 32.412,5);
+    else a comma between digits is a decimal comma."""
+    cells = [cell.strip() for row in rows for cell in row]
+    both = [c for c in cells if "." in c and "," in c and _BOTH_MARKS.match(c)]
+    if both:
+        return both[0].rfind(",") > both[0].rfind(".")
+    return any(_DECIMAL_COMMA.match(cell) for cell in cells)
 
 
 def _is_number(cell: str, decimal: str) -> bool:
-    try:
-        float(cell.strip().replace(decimal, ".") if decimal == "," else cell)
-    except ValueError:
-        return False
-    return True
+    return _plain(cell, decimal) is not None
+
+
+def _plain(cell: str, decimal: str) -> str | None:
+    """``cell`` as Python writes the number (decimal point, no grouping), or None when it
+    is no number."""
+    text = cell.strip().strip('"').strip()
+    candidates = [text.replace(decimal, ".") if decimal == "," else text]
+    grouped = re.fullmatch(rf"[+-]?\d{{1,3}}([{THOUSANDS[decimal]}])\d{{3}}(\1\d{{3}})*"
+                           rf"({re.escape(decimal)}\d*)?([eE][+-]?\d+)?", text)
+    if grouped:
+        candidates.append(text.replace(grouped.group(1), "").replace(decimal, "."))
+    for candidate in candidates:
+        try:
+            float(candidate)
+        except ValueError:
+            continue
+        return candidate
+    return None
 
 
 def _is_data(line: str, dialect: Dialect) -> bool:
@@ -229,21 +256,64 @@ def _delimiter(dialect: Dialect) -> str | None:
 
 
 def _numbers(body: list[str], dialect: Dialect, names: list[str], wanted: list[str],
-             where: str, offset: int) -> list[np.ndarray]:
-    """The ``wanted`` numeric columns, parsed in one pass over the data lines."""
+             where: str, offset: int) -> tuple[list[np.ndarray], str]:
+    """The ``wanted`` numeric columns, parsed in one pass over the data lines, and the
+    columns whose numbers group thousands (comma-separated names; empty: none)."""
     rows = body if dialect.decimal == "." else [line.replace(",", ".") for line in body]
+    columns = [names.index(n) for n in wanted]
     try:
-        table = np.loadtxt(rows, delimiter=_delimiter(dialect), quotechar='"', ndmin=2,
-                           usecols=[names.index(n) for n in wanted])
+        return _loaded(rows, dialect, columns), ""
     except ValueError as exc:
-        found = re.search(r"string '(.*)' to float64 at row (\d+), column (\d+)", str(exc))
-        if not found:
-            raise RunFormatError(f"{where}: unreadable values ({exc})") from None
-        line = int(found.group(2)) + offset + 1
-        column = names[int(found.group(3)) - 1]
-        raise RunFormatError(f"{where}: column {column}: unreadable value "
-                             f"{found.group(1)!r} at line {line}") from None
-    return list(table.T)
+        grouped = _grouped_columns(body, dialect, columns)
+        if not grouped:
+            raise _unreadable(exc, names, where, offset) from None
+    try:
+        return _loaded(_ungrouped(body, dialect, columns), dialect, columns), ", ".join(
+            names[k] for k in grouped)
+    except ValueError as exc:
+        raise _unreadable(exc, names, where, offset) from None
+
+
+def _loaded(rows: list[str], dialect: Dialect, columns: list[int]) -> list[np.ndarray]:
+    return list(np.loadtxt(rows, delimiter=_delimiter(dialect), quotechar='"', ndmin=2,
+                           usecols=columns).T)
+
+
+def _grouped_columns(body: list[str], dialect: Dialect, columns: list[int]) -> list[int]:
+    """The ``columns`` with a cell that groups thousands."""
+    found: list[int] = []
+    for line in body:
+        cells = split(line, dialect.separator)
+        found += [k for k in columns if k not in found and len(cells) > k
+                  and _plain(cells[k], dialect.decimal) not in
+                  (None, cells[k].strip().strip('"').replace(dialect.decimal, "."))]
+        if len(found) == len(columns):
+            break
+    return sorted(found)
+
+
+def _ungrouped(body: list[str], dialect: Dialect, columns: list[int]) -> list[str]:
+    """The data lines with the ``columns`` as Python writes numbers (cells it cannot read
+    left as they are, for the error to name)."""
+    wanted = set(columns)
+    out = []
+    for line in body:
+        cells = split(line, dialect.separator)
+        out.append(dialect.separator.join((_plain(c, dialect.decimal) or c) if k in wanted else
+                               "0" for k, c in enumerate(cells)))
+    return out
+
+
+def _unreadable(exc: ValueError, names: list[str], where: str, offset: int
+                ) -> RunFormatError:
+    found = re.search(r"string ['\"](.*)['\"] to float64 at row (\d+), column (\d+)",
+                      str(exc))
+    if not found:
+        return RunFormatError(f"{where}: unreadable values ({exc})")
+    line = int(found.group(2)) + offset + 1
+    column = names[int(found.group(3)) - 1]
+    return RunFormatError(f"{where}: column {column}: unreadable value {found.group(1)!r} "
+                          f"at line {line}")
 
 
 def _text(body: list[str], dialect: Dialect, index: int) -> np.ndarray:

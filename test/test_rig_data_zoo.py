@@ -141,6 +141,53 @@ def test_calendar_time_column_is_read_to_the_microsecond(tmp_path, run):
     assert back.time_s[0] == pytest.approx(start.astype("datetime64[us]").astype(int) * 1e-6)
 
 
+GROUPED = {  # separator, decimal mark, thousands mark
+    "comma thousands, decimal point": (";", ".", ","),
+    "point thousands, decimal comma": (";", ",", "."),
+    "apostrophe thousands (Swiss)": ("\t", ".", "'"),
+    "quoted comma thousands in a comma file": (",", ".", ","),
+}
+
+
+@pytest.mark.parametrize("layout", GROUPED.values(), ids=GROUPED.keys())
+def test_numbers_with_thousands_separators_read_as_the_same_run(tmp_path, run, layout):
+    """Issue 30: loads logged as 32,412.5 N (or 32.412,5) were refused."""
+    separator, decimal, thousands = layout
+    table = contract_table(run)
+
+    def cell(value: float, digits: int) -> str:
+        grouped = f"{value:,.{digits}f}".replace(",", "_").replace(".", decimal)
+        grouped = grouped.replace("_", thousands)
+        return f'"{grouped}"' if thousands == separator else grouped
+
+    rows = [separator.join(cell(table[c][k], 9 if c == "time_s" else 12) for c in CSV_COLUMNS)
+            for k in range(len(run))]
+    assert any(thousands in r for r in rows)
+    (tmp_path / "grouped.csv").write_text(separator.join(CSV_COLUMNS) + "\n"
+                                          + "\n".join(rows) + "\n")
+    assert_same_run(read_run(tmp_path / "grouped.csv"), run)
+
+
+def test_clock_time_of_day_is_read_as_seconds_across_midnight(tmp_path, run):
+    """Issue 30: a time column written as HH:MM:SS.ffffff was refused; a run that passes
+    midnight goes on counting."""
+    start_s = 24 * 3600 - 2.0  # 23:59:58
+    body = text(run).splitlines()
+
+    def clock(seconds: float) -> str:
+        seconds %= 24 * 3600
+        hours, rest = divmod(seconds, 3600)
+        minutes, secs = divmod(rest, 60)
+        return f"{int(hours):02d}:{int(minutes):02d}:{secs:09.6f}"
+
+    lines = [body[0]] + [f"{clock(start_s + t)}," + line.split(",", 1)[1]
+                         for t, line in zip(run.time_s, body[1:], strict=True)]
+    (tmp_path / "clock.csv").write_text("\n".join(lines) + "\n")
+    back = read_run(tmp_path / "clock.csv")
+    assert np.allclose(back.time_s - back.time_s[0], run.time_s - run.time_s[0], atol=1e-6)
+    assert any("clock" in note for note in back.notes)
+
+
 def test_mapping_scale_and_offset_fix_sign_and_absolute_pressure(tmp_path, run):
     table = contract_table(run)
     table["longitudinal_force_N"] = -table["longitudinal_force_N"]

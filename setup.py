@@ -50,7 +50,7 @@ setup(
             "ros-ament-index-python",
         ],
         # rig log formats beyond CSV, MATLAB v5 and bags (imported only when such a file is read)
-        "formats": ["h5py>=3.8", "pyarrow>=14", "asammdf>=7.4", "npTDMS>=1.7"],
+        "formats": ["h5py>=3.8", "pyarrow>=14", "asammdf>=7.4", "npTDMS>=1.7", "openpyxl>=3.1"],
         "test": [
             "landing_gear_sim[formats]",
             "pytest>=7",

@@ -23,7 +23,9 @@ from .text_table import MASTER_TIME, Table
 INSTALL_HINT = "pip install 'landing_gear_sim[formats]'"
 
 
-def _library(name: str, path: Path) -> ModuleType:
+def library(name: str, path: Path) -> ModuleType:
+    """The optional library ``name`` for reading ``path``, or an error with the hint to
+    install it."""
     try:
         return importlib.import_module(name)
     except ImportError:
@@ -72,7 +74,7 @@ def read_mat(path: Path) -> Table:
 
 def read_hdf5(path: Path) -> Table:
     """HDF5 (and MATLAB v7.3): every 1-D dataset, by its path and by its last name."""
-    h5py = _library("h5py", path)
+    h5py = library("h5py", path)
     named: list[tuple[str, Any]] = []
 
     def visit(name: str, node: Any) -> None:
@@ -89,7 +91,7 @@ def read_hdf5(path: Path) -> Table:
 
 
 def read_parquet(path: Path) -> Table:
-    parquet = _library("pyarrow.parquet", path)
+    parquet = library("pyarrow.parquet", path)
     try:
         table = parquet.read_table(path)
     except Exception as exc:  # pyarrow raises its own error types
@@ -100,7 +102,7 @@ def read_parquet(path: Path) -> Table:
 def read_mdf(path: Path) -> Table:
     """MDF 3/4: every channel on the time base of the first group's master channel,
     (channels of other rates are interpolated onto it)."""
-    asammdf = _library("asammdf", path)
+    asammdf = library("asammdf", path)
     try:
         with asammdf.MDF(path) as mdf:
             names = [n for n in mdf.channels_db if n not in ("t", "time")]
@@ -118,7 +120,7 @@ def read_mdf(path: Path) -> Table:
 def read_tdms(path: Path) -> Table:
     """TDMS: every channel by name and ``group/name``; the time from the waveform
     properties of the first channel, used when no channel holds it."""
-    nptdms = _library("nptdms", path)
+    nptdms = library("nptdms", path)
     try:
         channels = [c for g in nptdms.TdmsFile.read(path).groups() for c in g.channels()]
     except Exception as exc:  # npTDMS raises many types for damaged files

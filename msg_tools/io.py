@@ -10,12 +10,14 @@ import numpy as np
 
 from .bag_read import STORAGE_SUFFIXES, read_bag, storage_files
 from .binary_tables import READERS
-from .columns import run_from_table
+from .columns import run_from_table, text_columns, wanted_columns
 from .csv_io import read_csv, run_name
 from .errors import RunFormatError
-from .mapping import Mapping
+from .mapping import DEFAULT_MAPPING, Mapping
 from .run import Run
 from .timebase import split_at_gaps
+from .workbook import SUFFIXES as WORKBOOK_SUFFIXES
+from .workbook import read_workbook
 
 TEXT_SUFFIXES = (".csv", ".txt", ".tsv", ".dat", ".asc")
 NOT_RUNS = (".yaml", ".yml", ".json", ".md", ".rst", ".html", ".png", ".svg", ".pdf", ".log",
@@ -43,13 +45,15 @@ def _lost_its_metadata(folder: Path) -> bool:
 
 
 def _kind(path: Path) -> str:
-    """``bag``, ``text``, ``binary``, ``other`` (not a run) or ``unknown``."""
+    """``bag``, ``text``, ``workbook``, ``binary``, ``other`` (not a run) or ``unknown``."""
     suffixes = [s.lower() for s in path.suffixes[-2:]]
     last = suffixes[-1] if suffixes else ""
     if is_bag(path):
         return "bag"
     if last in TEXT_SUFFIXES or (last == ".gz" and suffixes[0] in TEXT_SUFFIXES):
         return "text"
+    if last in WORKBOOK_SUFFIXES:
+        return "workbook"
     if last in READERS:
         return "binary"
     return "other" if last in NOT_RUNS or path.is_dir() else "unknown"
@@ -65,11 +69,16 @@ def read_run(path: Path, mapping: Mapping | None = None, name: str | None = None
         return read_bag(path, name, mapping)
     if kind == "text":
         return read_csv(path, name, mapping)
+    if kind == "workbook":
+        mapping = mapping or DEFAULT_MAPPING
+        table = read_workbook(path, wanted_columns(mapping), text_columns(mapping))
+        return run_from_table(table, str(path), name or run_name(path), mapping)
     if kind == "binary":
         table = READERS[path.suffix.lower()](path)
         return run_from_table(table, str(path), name or run_name(path), mapping)
-    raise RunFormatError(f"{path}: not a run file (reads .csv/.txt/.tsv[.gz], .mat, .h5, "
-                         ".parquet, .mf4, .tdms, rosbag2 folders, .mcap, .db3, ROS 1 .bag)")
+    raise RunFormatError(f"{path}: not a run file (reads .csv/.txt/.tsv[.gz], .xlsx, .mat, "
+                         ".h5, .parquet, .mf4, .tdms, rosbag2 folders, .mcap, .db3, ROS 1 "
+                         ".bag)")
 
 
 @dataclass(frozen=True)

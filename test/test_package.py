@@ -46,6 +46,7 @@ NO_KEY = {"threadpoolctl": "comes with python3-sklearn",
           "dask": "history and montecarlo only; no rosdep key (setup.py brings it)",
           "distributed": "the same", "pyarrow": "the formats extra, read only when asked",
           "h5py": "the same", "asammdf": "the same", "nptdms": "the same",
+          "openpyxl": "the same",
           "mcap": "a cut .mcap recovered; no key of its own (rosdistro, Aug 2026: only "
                   "mcap-ros2-support); setup.py brings it"}
 OWN = {"landing_gear_sim", "antiskid", "msg_tools"}

@@ -204,6 +204,40 @@ def test_mapping_scale_and_offset_fix_sign_and_absolute_pressure(tmp_path, run):
     assert_same_run(read_run(tmp_path / "fixed.csv"), run, time_atol=1e-6)
 
 
+def test_an_excel_workbook_reads_as_the_same_run_from_the_sheet_holding_it(tmp_path, run):
+    """Issue 30: .xlsx was not read. A test bench's export: a notes sheet first, then the
+    data sheet with a title row, units in the header cells and numbers as Excel keeps
+    them (floats); the run is read from the sheet that holds it, and a campaign folder
+    takes the workbook as a run."""
+    openpyxl = pytest.importorskip("openpyxl")
+    book = openpyxl.Workbook()
+    book.active.title = "Notes"
+    book.active.append(["Prüfstand HIL-3, Bremse links"])
+    sheet = book.create_sheet("Messung")
+    sheet.append(["Run 7, 2024-05-02"])
+    units = ["s", "A", "bar", "rad/s", "rad/s", "N", "N"]
+    sheet.append([f"{c} [{u}]" for c, u in zip(CSV_COLUMNS, units, strict=True)])
+    table = contract_table(run)
+    for k in range(len(run)):
+        sheet.append([float(table[c][k]) for c in CSV_COLUMNS])
+    (tmp_path / "camp").mkdir()
+    book.save(tmp_path / "camp" / "run7.xlsx")
+    assert_same_run(read_run(tmp_path / "camp" / "run7.xlsx"), run)
+    assert [r.name for r in read_campaign(tmp_path / "camp").runs] == ["run7"]
+
+
+def test_a_workbook_without_the_run_lists_its_sheets_and_their_columns(tmp_path):
+    openpyxl = pytest.importorskip("openpyxl")
+    book = openpyxl.Workbook()
+    book.active.title = "Temperatures"
+    book.active.append(["t", "T_disc"])
+    for k in range(50):
+        book.active.append([0.1 * k, 20.0 + k])
+    book.save(tmp_path / "other.xlsx")
+    with pytest.raises(RunFormatError, match=r"sheet Temperatures: .*t, T_disc"):
+        read_run(tmp_path / "other.xlsx")
+
+
 # ---------------------------------------------------------------- binary tables
 
 
@@ -367,7 +401,7 @@ def test_campaign_reads_sub_folders_and_skips_junk_with_a_note(tmp_path, run):
     campaign = read_campaign(tmp_path)
     assert [r.name for r in campaign.runs] == ["b", "day1__a"]
     assert len(campaign.problems) == 2
-    assert any("notes.xlsx: not a run file" in p for p in campaign.problems)
+    assert any("notes.xlsx: cannot read the workbook" in p for p in campaign.problems)
     assert any("broken.mat" in p for p in campaign.problems)
 
 

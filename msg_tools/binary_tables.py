@@ -100,21 +100,37 @@ def read_parquet(path: Path) -> Table:
 
 
 def read_mdf(path: Path) -> Table:
-    """MDF 3/4: every channel on the time base of the first group's master channel,
-    (channels of other rates are interpolated onto it)."""
+    """MDF 3/4: every channel of every group on the time base of the fastest group, the
+    slower ones resampled onto it (said in a note); a name in several groups is taken from
+    the fastest of them (asammdf refuses a bare duplicated name: the whole file was)."""
     asammdf = library("asammdf", path)
     try:
         with asammdf.MDF(path) as mdf:
-            names = [n for n in mdf.channels_db if n not in ("t", "time")]
-            signals = mdf.select(names, raw=False)
+            places = [(name, group, index) for name, found in mdf.channels_db.items()
+                      for group, index in found if index != mdf.masters_db.get(group)]
+            signals = mdf.select(places, raw=False) if places else []
     except Exception as exc:  # asammdf raises many types for damaged files
         raise RunFormatError(f"{path}: cannot read MDF file ({exc})") from None
     if not signals:
         raise RunFormatError(f"{path}: the MDF file holds no channel")
-    base = signals[0].timestamps
-    named = [(MASTER_TIME, base)] + [(s.name, s.interp(base).samples) for s in signals]
-    units = {s.name: s.unit for s in signals if s.unit}
-    return Table(_same_length(named), {MASTER_TIME: "s", **units})
+    chosen: dict[str, Any] = {}
+    for signal in sorted(signals, key=lambda s: -_rate_hz(s.timestamps)):
+        chosen.setdefault(signal.name, signal)
+    base = max(chosen.values(), key=lambda s: _rate_hz(s.timestamps)).timestamps
+    slower = sorted({round(_rate_hz(s.timestamps), 3) for s in chosen.values()
+                     if not np.array_equal(s.timestamps, base)})
+    named = [(MASTER_TIME, base)] + [
+        (name, s.samples if np.array_equal(s.timestamps, base) else s.interp(base).samples)
+        for name, s in chosen.items()]
+    units = {s.name: s.unit for s in chosen.values() if s.unit}
+    notes = (f"{path}: channels at {', '.join(f'{r:g}' for r in slower)} Hz resampled onto "
+             f"the fastest group's {_rate_hz(base):g} Hz time base",) if slower else ()
+    return Table(_same_length(named), {MASTER_TIME: "s", **units}, notes)
+
+
+def _rate_hz(timestamps: np.ndarray) -> float:
+    span = float(timestamps[-1] - timestamps[0]) if timestamps.size > 1 else 0.0
+    return (timestamps.size - 1) / span if span > 0 else 0.0
 
 
 def read_tdms(path: Path) -> Table:

@@ -304,6 +304,27 @@ def test_binary_formats_read_as_the_same_run(tmp_path, run, name, writer):
     assert_same_run(read_run(tmp_path / name), run)
 
 
+def test_an_mdf4_of_several_rates_and_a_duplicated_name_reads_the_run_at_its_own_rate(
+        tmp_path, run):
+    """Issue 30: a first channel group at 10 Hz decimated the 1 kHz run to 10 Hz without a
+    word, and one channel name in two groups refused the whole file. The run is read on
+    the fastest group's time base, slower channels resampled onto it with a note; a
+    duplicated name the run does not need does not matter."""
+    asammdf = pytest.importorskip("asammdf")
+    table = columns(run)
+    time = table.pop("time_s")
+    slow = np.arange(time[0], time[-1], 0.1)
+    with asammdf.MDF(version="4.10") as mdf:
+        mdf.append([asammdf.Signal(20.0 + slow, slow, name="disc_temperature", unit="degC"),
+                    asammdf.Signal(np.ones_like(slow), slow, name="status")])
+        mdf.append([asammdf.Signal(values, time, name=name) for name, values in table.items()])
+        mdf.append([asammdf.Signal(21.0 + slow, slow, name="disc_temperature", unit="degC")])
+        mdf.save(tmp_path / "rates.mf4", overwrite=True)
+    back = read_run(tmp_path / "rates.mf4")
+    assert_same_run(back, run)
+    assert any("10 Hz" in note and "resampled" in note for note in back.notes), back.notes
+
+
 # ---------------------------------------------------------------- bags
 
 

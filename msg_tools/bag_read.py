@@ -63,7 +63,7 @@ def read_bag(path: Path, name: str | None = None, mapping: Mapping | None = None
     where = str(path)
     try:
         with recovered(bag_paths(path)) as (paths, notes), \
-                AnyReader(paths, default_typestore=TYPESTORE) as reader:
+                _without_interfaces(AnyReader(paths, default_typestore=TYPESTORE)) as reader:
             types = {c.topic: c.msgtype for c in reader.connections}
             sources = resolve(mapping or DEFAULT_MAPPING, types, where)
             series, read = _stream(reader, sources)
@@ -75,6 +75,41 @@ def read_bag(path: Path, name: str | None = None, mapping: Mapping | None = None
     fields = _on_wheel_base(series, sources, where)
     check_plausible(fields, where)
     return Run(name=name or path.stem, source=where, notes=tuple(notes), **fields)
+
+
+def _without_interfaces(reader: AnyReader) -> AnyReader:
+    """``reader`` blind to service-event and action topics (``pkg/srv/X_Event``, what
+    ``ros2 bag record --all-services`` adds): rosbags names their types ``pkg/srv/msg/X``
+    and, checking their hashes, refused every bag that held one. A run never lives there."""
+    reader.readers = [_Topics(sub) for sub in reader.readers]  # type: ignore[assignment]
+    return reader
+
+
+class _Topics:
+    """A rosbags sub-reader with its message topics only (see :func:`_without_interfaces`)."""
+
+    def __init__(self, reader: Any) -> None:
+        self._reader = reader
+
+    def __enter__(self) -> _Topics:
+        self._reader.__enter__()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._reader.__exit__(*exc)
+
+    @property
+    def connections(self) -> list[Any]:
+        return [c for c in self._reader.connections
+                if not any(f"/{kind}/" in c.msgtype for kind in ("srv", "action"))]
+
+    @property
+    def topics(self) -> dict[str, Any]:
+        kept = {c.topic for c in self.connections}
+        return {t: info for t, info in self._reader.topics.items() if t in kept}
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._reader, name)
 
 
 def _lost(reader: AnyReader, read: Counter[str]) -> list[str]:

@@ -353,6 +353,39 @@ def test_bag_under_another_namespace_is_found_by_topic_tail(tmp_path, run):
     assert_same_run(read_run(tmp_path / "ns"), run)
 
 
+SEPARATOR = "=" * 80 + "\n"
+SERVICE_EVENT_DEF = (  # as rosbag2 stores rcl_interfaces/srv/GetParameters_Event
+    "service_msgs/ServiceEventInfo info\nGetParameters_Request[<=1] request\n"
+    "GetParameters_Response[<=1] response\n" + SEPARATOR
+    + "MSG: service_msgs/ServiceEventInfo\nuint8 event_type\nbuiltin_interfaces/Time stamp\n"
+    "char[16] client_gid\nint64 sequence_number\n" + SEPARATOR
+    + "MSG: rcl_interfaces/GetParameters_Request\nstring[] names\n" + SEPARATOR
+    + "MSG: rcl_interfaces/GetParameters_Response\nParameterValue[] values\n" + SEPARATOR
+    + "MSG: rcl_interfaces/ParameterValue\nuint8 type\nfloat64 double_value\n")
+
+
+def test_a_bag_recorded_with_service_events_reads_its_topics(tmp_path, run):
+    """Issue 30: `ros2 bag record --all-services` adds `pkg/srv/X_Event` topics, which
+    rosbags cannot name; a bag holding one was refused whole ('cannot read bag
+    ('rcl_interfaces/srv/GetParameters_Event')')."""
+    from rosbags.rosbag2 import Writer
+
+    from msg_tools.bag_io import BAG_VERSION, TOPIC_TYPES, contract_messages
+
+    with Writer(tmp_path / "bag", version=BAG_VERSION) as writer:
+        topics = {t: writer.add_connection(t, kind, typestore=TYPESTORE)
+                  for t, kind in TOPIC_TYPES.items()}
+        event = writer.add_connection(
+            "/rig/plant/get_parameters/_service_event", "rcl_interfaces/srv/GetParameters_Event",
+            msgdef=SERVICE_EVENT_DEF, rihs01="RIHS01_" + "0" * 64)
+        writer.write(event, 1, bytes(4 + 64))
+        for k in range(len(run)):
+            for topic, message in contract_messages(run, k).items():
+                writer.write(topics[topic], round(float(run.time_s[k]) * 1e9),
+                             TYPESTORE.serialize_cdr(message, TOPIC_TYPES[topic]))
+    assert_same_run(read_run(tmp_path / "bag"), run, time_atol=1e-6)
+
+
 def test_bag_topics_named_otherwise_need_and_take_a_mapping(tmp_path, run):
     write_bag(run, tmp_path / "bag")
     rewrite_bag(tmp_path / "bag", tmp_path / "other",

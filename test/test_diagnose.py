@@ -219,6 +219,9 @@ def test_cli_writes_the_contract_json_and_the_report(reference, tmp_path, capsys
     ("pressure_sensor_offset.offset_pa", -1.2e5, 300.0, "offset = -1.2 ± 0.003 bar"),
     ("brake_fade.fade_fraction", 0.12, None, "fade_fraction = 12 %"),
     ("friction.theta1", 0.8123, 0.004, "theta1 = 0.8123 ± 0.004"),
+    # were 'gain_drift_per_run = -0.03475 ± 1.4e-05' (I09) and a load law read in kN
+    ("gain_drift_per_run", -0.03475, 1.4e-5, "gain_drift = -3.475 ± 0.0014 %/run"),
+    ("load_sensitivity_per_n", 1.022e-5, 2.9e-8, "load_sensitivity = 1.022 ± 0.0029 %/kN"),
 ])
 def test_a_parameter_reads_in_engineering_units(key, value, std, text):
     assert parameter_text(key, value, std) == text

@@ -99,15 +99,19 @@ def verdict_text(result: Diagnosis) -> str:
 
 
 KEY_UNITS = {"s": "s", "pa": "Pa", "n": "N", "a": "A", "m": "m", "j": "J", "hz": "Hz",
-             "fraction": "1"}
-"""A parameter key's last word -> its SI unit (a key carries its unit, docs/parameters.md)."""
+             "fraction": "1", "run": "run"}
+"""A parameter key's last word -> its SI unit (a key carries its unit, docs/parameters.md;
+``x_per_n``: per newton)."""
 
 
 def parameter_text(key: str, value: float, std: float | None) -> str:
     """``name = value ± σ`` in the unit a brake engineer reads, e.g. 'delay = 5.99 ± 0.29 ms'
-    for ``actuator_delay.delay_s`` (issue 32: 0.0059941 ± 0.00029 s)."""
+    for ``actuator_delay.delay_s`` (issue 32: 0.0059941 ± 0.00029 s), 'gain_drift = −3.475 ±
+    0.0014 %/run' for ``gain_drift_per_run``."""
     name, _, suffix = key.rsplit(".", 1)[-1].rpartition("_")
     unit = KEY_UNITS.get(suffix)
+    if unit is not None and name.endswith("_per"):
+        name, unit = name.removesuffix("_per"), f"1/{unit}"
     if unit is None or unit == "1":
         name = key.rsplit(".", 1)[-1]
     if unit is None:

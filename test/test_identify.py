@@ -22,6 +22,7 @@ from landing_gear_sim.calibration.campaign import (
 from landing_gear_sim.calibration.friction import fit_friction
 from landing_gear_sim.calibration.identify import MAX_SLIP_STIFFNESS, MAX_THETA1, identify
 from landing_gear_sim.calibration.measured import run_static_load_n, simulate_run
+from landing_gear_sim.calibration.plausibility import unit_notes
 from landing_gear_sim.calibration.runs import (
     Family,
     RunKind,
@@ -368,6 +369,40 @@ def test_a_unit_within_physical_ranges_is_still_named(campaign_dir, tmp_path, ca
     assert all(f in error for f in fragments), error
     assert f"{run_name}.csv" in error and "Traceback" not in error
     assert not (tmp_path / "out.yaml").exists()
+
+
+def _pressure_rewritten(campaign_dir, folder, change):
+    """The campaign with every run's pressure [bar] passed through ``change``."""
+    folder.mkdir()
+    for source in campaign_dir.glob("*.csv"):
+        lines = source.read_text().splitlines()
+        k = lines[0].split(",").index("brake_pressure_bar")
+        lines = lines[:1] + [",".join(f"{change(float(v)):.12g}" if i == k else v
+                                      for i, v in enumerate(line.split(",")))
+                             for line in lines[1:]]
+        (folder / source.name).write_text("\n".join(lines) + "\n")
+    return folder
+
+
+def test_an_absolute_pressure_is_named_in_the_calibrations_notes(campaign_dir, tmp_path,
+                                                                 reference):
+    """Issue 30: a pressure logged absolute (1.013 bar at zero current) was calibrated
+    silently: dead-band −16 %, brake gain −3 %, no note."""
+    folder = _pressure_rewritten(campaign_dir, tmp_path / "absolute", lambda bar: bar + 1.01325)
+    result = identify(read_campaign(folder).runs, reference, jackknife=False)
+    notes = [p for p in result.problems if "absolute" in p]
+    assert notes and "1.01 bar at zero current" in notes[0], result.problems
+    assert not [p for p in identify(read_campaign(campaign_dir).runs, reference,
+                                    jackknife=False).problems if "absolute" in p]
+
+
+def test_a_clipping_pressure_sensor_is_named(campaign_dir, tmp_path, reference):
+    """Issue 30: a transducer that saturated at 25 bar was taken for the valve's maximum."""
+    folder = _pressure_rewritten(campaign_dir, tmp_path / "clipped", lambda bar: min(bar, 25.0))
+    runs = classify_all(read_campaign(folder).runs)
+    notes = unit_notes(runs, reference)
+    assert any("25 bar" in n and "clipp" in n for n in notes), notes
+    assert unit_notes(classify_all(read_campaign(campaign_dir).runs), reference) == []
 
 
 def test_a_campaign_that_cannot_identify_everything_writes_only_when_asked(campaign_dir,

@@ -29,7 +29,7 @@ from landing_gear_sim.calibration.actuator import (
 )
 from landing_gear_sim.calibration.friction import KEYS as FRICTION_KEYS
 from landing_gear_sim.calibration.friction import fit_friction, refine_friction
-from landing_gear_sim.calibration.plausibility import check_units
+from landing_gear_sim.calibration.plausibility import check_units, unit_notes
 from landing_gear_sim.calibration.runs import ClassifiedRun, Family, RunKind, classify_all, select
 from landing_gear_sim.calibration.statistics import Estimate
 from landing_gear_sim.errors import IdentificationError, ParameterError
@@ -122,6 +122,7 @@ def _identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool,
     state = _Calibration(base, progress or (lambda _msg: None))
     classified = classify_all(runs)
     check_units(classified, base)
+    state.problems.extend(unit_notes(classified, base))
     ramps = select(classified, [RunKind.ACTUATOR_RAMP])
     dynamic = select(classified, [RunKind.ACTUATOR_DYNAMIC])
     braking = select(classified, [Family.BRAKE])

@@ -5,6 +5,10 @@ within any physical range; but before braking the wheel rolls freely on the flyw
 rim speeds), the valve's pressure follows its current through the datasheet map within
 tens of percent, and over a stop the flywheel loses the momentum the load cell's force
 takes from it. A ratio far from 1 that matches a unit factor names the unit.
+
+What still calibrates but may mislead is a note (:func:`unit_notes`): a pressure that reads
+one atmosphere at zero current (logged absolute), a pressure flat at its top while the
+valve's current asks for more (a transducer clipping).
 """
 
 from __future__ import annotations
@@ -20,12 +24,17 @@ from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model.actuator import actuator_pressure
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s, rolling_radius_at
+from landing_gear_sim.model.scenario import BRAKE_ON_CURRENT_A
 from msg_tools.checks import CONTACT_LOAD_N, MIN_BRAKING_SAMPLES, TURNING_RAD_S
 from msg_tools.units import PA_PER_BAR, UNITS
 
 PLAUSIBLE_RATIO = (0.5, 2.0)  # measured/expected: other rigs differ, not by a unit factor
 MATCH = 0.15  # a ratio within 15 % of a unit factor is taken for that unit
 VALVE_PRESSURE_PA = 5 * PA_PER_BAR  # compare where the valve map is clear of its dead-band
+ATMOSPHERE_PA = 101325.0
+ABSOLUTE_MATCH_PA = 0.05 * PA_PER_BAR  # a pressure at rest this close to one atmosphere
+CLIP_SAMPLES = 50  # a flat top held this long ...
+CLIP_HEADROOM = 1.1  # ... where the valve map gives this much more is a clipping sensor
 
 
 def check_units(runs: Sequence[ClassifiedRun], params: RigParameters) -> None:
@@ -34,6 +43,45 @@ def check_units(runs: Sequence[ClassifiedRun], params: RigParameters) -> None:
         _check_speeds(run, params)
         _check_pressure(run, params)
         _check_momentum(run, params)
+
+
+def unit_notes(runs: Sequence[ClassifiedRun], params: RigParameters) -> list[str]:
+    """What the runs still calibrate with but a user should hear of: an absolute pressure,
+    a clipping pressure transducer (each a note; empty: nothing)."""
+    return [note for note in (_absolute_pressure(runs), _clipped_pressure(runs, params))
+            if note]
+
+
+def _absolute_pressure(runs: Sequence[ClassifiedRun]) -> str | None:
+    at_rest = np.concatenate([r.pressure_pa[r.current_a < BRAKE_ON_CURRENT_A] for r in runs])
+    if at_rest.size < MIN_BRAKING_SAMPLES:
+        return None
+    level = float(np.median(at_rest))
+    if abs(level - ATMOSPHERE_PA) > ABSOLUTE_MATCH_PA:
+        return None
+    return (f"brake_pressure_bar reads {level / PA_PER_BAR:.2f} bar at zero current: logged "
+            "absolute? The model's pressure is gauge (a column mapping with offset: -1.01325 "
+            "reads it so); a transducer offset reads the same, and the diagnosis may name it "
+            "pressure_sensor_offset")
+
+
+def _clipped_pressure(runs: Sequence[ClassifiedRun], params: RigParameters) -> str | None:
+    clipped: dict[str, tuple[float, int, float]] = {}
+    for run in runs:
+        top = float(np.max(run.pressure_pa))
+        flat = run.pressure_pa >= top - 1e-9 * abs(top)
+        if top <= VALVE_PRESSURE_PA or flat.sum() < CLIP_SAMPLES:
+            continue
+        asked = float(np.max(actuator_pressure(params, run.current_a, run.rate_hz)[flat]))
+        if asked > CLIP_HEADROOM * top:
+            clipped[run.name] = (top, int(flat.sum()), asked)
+    if not clipped:
+        return None
+    top = min(v[0] for v in clipped.values())
+    return (f"brake_pressure_bar stays flat at {top / PA_PER_BAR:.3g} bar in "
+            f"{', '.join(clipped)} ({sum(v[1] for v in clipped.values())} samples) where the "
+            f"valve map gives up to {max(v[2] for v in clipped.values()) / PA_PER_BAR:.3g} "
+            "bar: a transducer clipping there? Its samples read the pressure low")
 
 
 def _likely(ratio: float, quantity: str, contract_unit: str) -> str | None:

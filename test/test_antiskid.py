@@ -132,3 +132,22 @@ def test_metrics_of_an_actuator_only_run_is_one_error_line(tmp_path, capsys, ref
     assert main(["metrics", str(tmp_path / "act.csv")]) == 2
     assert "not a braking run" in capsys.readouterr().err
 
+
+
+@pytest.mark.parametrize(("field", "factor", "fragment"), [
+    ("wheel_speed_rad_s", 60 / (2 * np.pi), "looks like rpm"),  # was: slip −7.8 accepted
+    ("pressure_pa", 1e5 / 6894.757293168361, "looks like psi"),  # was: 'cycling 224 Hz'
+])
+def test_metrics_of_a_run_with_a_unit_mixed_up_names_the_unit(tmp_path, capsys, reference,
+                                                              field, factor, fragment):
+    """Issue 30: `metrics` checks a single run by the rig's redundancy, as identify does."""
+    import dataclasses
+
+    from msg_tools.csv_io import write_csv
+
+    run = simulate(reference, sc.constant_pressure_test(reference, 20e5)).to_run(3)
+    write_csv(dataclasses.replace(run, **{field: getattr(run, field) * factor}),
+              tmp_path / "run.csv")
+    assert main(["metrics", str(tmp_path / "run.csv")]) == 2
+    error = capsys.readouterr().err
+    assert fragment in error and "Traceback" not in error, error

@@ -226,11 +226,15 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
 
 def cmd_metrics(args: argparse.Namespace) -> int:
     from antiskid.metrics import braking_metrics
+    from landing_gear_sim.calibration.plausibility import check_units
+    from landing_gear_sim.calibration.runs import classify_all
     from landing_gear_sim.report.braking import metrics_table
 
     check_outputs(files=[args.json, args.plot])
     rig = params_of(args)
     run = read_one(args.run, mapping_of(args))
+    # a unit within every range (a wheel in rpm: slip −7.8 accepted) named as identify does
+    check_units(classify_all([run]), rig)
     metrics = braking_metrics(run, rig)
     print(metrics_table({run.name: metrics}))
     _write_braking_outputs(args, run, rig, metrics)

@@ -16,6 +16,7 @@ from landing_gear_sim.calibration.campaign import generate_campaign, rig_like, s
 from landing_gear_sim.calibration.identify import identify
 from landing_gear_sim.calibration.logger import Logger
 from landing_gear_sim.calibration.measured import CHANNELS, simulate_all
+from landing_gear_sim.calibration.plausibility import unit_notes
 from landing_gear_sim.calibration.runs import classify_all
 from landing_gear_sim.diagnosis.catalogue import (
     fade_reach,
@@ -131,6 +132,16 @@ def test_a_counting_encoder_counts_the_lines_of_what_its_channel_reads(reference
     true = wheel_angle_rad(result.time_s, result.wheel_speed_rad_s)[1:]
     assert np.max(np.abs(counted - read)) <= 1.01 * line
     assert np.max(np.abs(counted - true)) > 2.0 * line
+
+
+@pytest.mark.parametrize("lines", [64, 256])
+def test_a_counted_wheel_channel_is_named_with_its_resolution(reference, tmp_path, lines):
+    """Through 64 lines a 5.6 ms wheel skew or a 2 % encoder ripple read 'none' with nothing
+    said of why: the encoder's resolution, estimated from the data, is in the notes."""
+    runs, _ = _campaign(reference, tmp_path, 214, logger=Logger(encoder_counts=lines),
+                        names=BRAKING)
+    notes = unit_notes(classify_all(runs), reference)
+    assert any(f"{lines} lines per revolution" in n for n in notes), notes
 
 
 def test_a_hyperbolic_fade_is_measured_with_its_shape(reference, tmp_path):

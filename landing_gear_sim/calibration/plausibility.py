@@ -8,7 +8,8 @@ takes from it. A ratio far from 1 that matches a unit factor names the unit.
 
 What still calibrates but may mislead is a note (:func:`unit_notes`): a pressure that reads
 one atmosphere at zero current (logged absolute), a pressure flat at its top while the
-valve's current asks for more (a transducer clipping).
+valve's current asks for more (a transducer clipping), a wheel speed counted from an
+encoder's lines (its resolution named).
 """
 
 from __future__ import annotations
@@ -48,8 +49,8 @@ def check_units(runs: Sequence[ClassifiedRun], params: RigParameters) -> None:
 def unit_notes(runs: Sequence[ClassifiedRun], params: RigParameters) -> list[str]:
     """What the runs still calibrate with but a user should hear of: an absolute pressure,
     a clipping pressure transducer (each a note; empty: nothing)."""
-    return [note for note in (_absolute_pressure(runs), _clipped_pressure(runs, params))
-            if note]
+    return [note for note in (_absolute_pressure(runs), _clipped_pressure(runs, params),
+                              _counted_wheel(runs)) if note]
 
 
 def _absolute_pressure(runs: Sequence[ClassifiedRun]) -> str | None:
@@ -82,6 +83,40 @@ def _clipped_pressure(runs: Sequence[ClassifiedRun], params: RigParameters) -> s
             f"{', '.join(clipped)} ({sum(v[1] for v in clipped.values())} samples) where the "
             f"valve map gives up to {max(v[2] for v in clipped.values()) / PA_PER_BAR:.3g} "
             "bar: a transducer clipping there? Its samples read the pressure low")
+
+
+def _counted_wheel(runs: Sequence[ClassifiedRun]) -> str | None:
+    """The wheel channel of a counting encoder (its speeds on a lattice: whole lines per
+    sample), with the lines per revolution that lattice means."""
+    braking = [r for r in runs if r.braking]
+    steps = [lattice_step(r.wheel_speed_rad_s) for r in braking]
+    if not braking or None in steps:
+        return None
+    step = float(np.median([s for s in steps if s is not None]))
+    rate = float(np.median([r.rate_hz for r in braking]))
+    return (f"wheel_speed_rad_s is counted: {2 * math.pi * rate / step:.0f} lines per "
+            f"revolution ({step:.3g} rad/s per count at {rate:g} Hz); effects in the wheel "
+            "channel (a skew, a ripple with its angle) are judged through that resolution, "
+            "and small ones may not show")
+
+
+LATTICE_SHARE = 0.01  # a counted channel takes no more distinct values than this share ...
+LATTICE_LEVELS = 3  # ... and at least this many
+
+
+def lattice_step(values: np.ndarray) -> float | None:
+    """The step of the lattice ``values`` sit on (a counting encoder's speed per count), or
+    None when they take many values (an analogue channel)."""
+    levels = np.unique(values)
+    if levels.size > LATTICE_SHARE * values.size:
+        return None
+    # a log's last digit splits a level in two (24.5436926 and 24.5436926001)
+    levels = levels[np.r_[True, np.diff(levels) > 1e-6 * float(np.max(np.abs(levels)))]]
+    if levels.size < LATTICE_LEVELS:
+        return None
+    step = float(np.min(np.diff(levels)))
+    multiples = (levels - levels[0]) / step
+    return step if float(np.max(np.abs(multiples - np.round(multiples)))) < 1e-3 else None
 
 
 def _likely(ratio: float, quantity: str, contract_unit: str) -> str | None:

@@ -177,18 +177,23 @@ def _plain(cell: str, decimal: str) -> str | None:
     """``cell`` as Python writes the number (decimal point, no grouping), or None when it
     is no number."""
     text = cell.strip().strip('"').strip()
-    candidates = [text.replace(decimal, ".") if decimal == "," else text]
+    plain = text.replace(decimal, ".") if decimal == "," else text
+    if _is_float(plain):
+        return plain
     grouped = re.fullmatch(rf"[+-]?\d{{1,3}}([{THOUSANDS[decimal]}])\d{{3}}(\1\d{{3}})*"
                            rf"({re.escape(decimal)}\d*)?([eE][+-]?\d+)?", text)
-    if grouped:
-        candidates.append(text.replace(grouped.group(1), "").replace(decimal, "."))
-    for candidate in candidates:
-        try:
-            float(candidate)
-        except ValueError:
-            continue
-        return candidate
-    return None
+    if grouped is None:
+        return None
+    plain = text.replace(grouped.group(1), "").replace(decimal, ".")
+    return plain if _is_float(plain) else None
+
+
+def _is_float(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def _is_data(line: str, dialect: Dialect) -> bool:
@@ -299,8 +304,9 @@ def _ungrouped(body: list[str], dialect: Dialect, columns: list[int]) -> list[st
     out = []
     for line in body:
         cells = split(line, dialect.separator)
-        out.append(dialect.separator.join((_plain(c, dialect.decimal) or c) if k in wanted else
-                               "0" for k, c in enumerate(cells)))
+        out.append(dialect.separator.join(
+            (_plain(c, dialect.decimal) or c) if k in wanted else "0"
+            for k, c in enumerate(cells)))
     return out
 
 

@@ -36,6 +36,8 @@ ATMOSPHERE_PA = 101325.0
 ABSOLUTE_MATCH_PA = 0.05 * PA_PER_BAR  # a pressure at rest this close to one atmosphere
 CLIP_SAMPLES = 50  # a flat top held this long ...
 CLIP_HEADROOM = 1.1  # ... where the valve map gives this much more is a clipping sensor
+LATTICE_SHARE = 0.01  # a counted channel takes no more distinct values than this share ...
+LATTICE_LEVELS = 3  # ... and at least this many
 
 
 def check_units(runs: Sequence[ClassifiedRun], params: RigParameters) -> None:
@@ -48,7 +50,8 @@ def check_units(runs: Sequence[ClassifiedRun], params: RigParameters) -> None:
 
 def unit_notes(runs: Sequence[ClassifiedRun], params: RigParameters) -> list[str]:
     """What the runs still calibrate with but a user should hear of: an absolute pressure,
-    a clipping pressure transducer (each a note; empty: nothing)."""
+    a clipping pressure transducer, a counted wheel channel and its resolution (each a
+    note; empty: nothing)."""
     return [note for note in (_absolute_pressure(runs), _clipped_pressure(runs, params),
                               _counted_wheel(runs)) if note]
 
@@ -98,10 +101,6 @@ def _counted_wheel(runs: Sequence[ClassifiedRun]) -> str | None:
             f"revolution ({step:.3g} rad/s per count at {rate:g} Hz); effects in the wheel "
             "channel (a skew, a ripple with its angle) are judged through that resolution, "
             "and small ones may not show")
-
-
-LATTICE_SHARE = 0.01  # a counted channel takes no more distinct values than this share ...
-LATTICE_LEVELS = 3  # ... and at least this many
 
 
 def lattice_step(values: np.ndarray) -> float | None:

@@ -6,6 +6,7 @@ for a measured run); everything else from the run's signals.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -22,7 +23,7 @@ from landing_gear_sim.model.quantities import (
     rim_speed_m_s,
     rolling_radius_at,
 )
-from landing_gear_sim.model.scenario import brake_start_index
+from landing_gear_sim.model.scenario import BRAKE_ON_CURRENT_A, brake_start_index
 from msg_tools.run import Run
 from msg_tools.units import PA_PER_BAR
 
@@ -31,6 +32,9 @@ LOCK_MIN_SPEED_M_S = 5.0  # locks below this speed are the stop itself, not a sk
 MIN_LOAD_N = 1000.0  # below this the wheel is not on the flywheel: no friction to speak of
 CYCLE_PROMINENCE_PA = 2 * PA_PER_BAR  # a pressure cycle is a peak standing 2 bar above its valleys
 GEAR_WALK_BAND = 0.3  # cycling within ±30 % of the gear-walk frequency is flagged
+# the brake off this long ends a stop: an anti-skid release lasts tens of milliseconds, the
+# rig takes seconds to spin the flywheel up again (2 s of free rolling before each stop)
+STOP_GAP_S = 1.0
 
 
 @dataclass(frozen=True)
@@ -62,6 +66,20 @@ def braking_window(run: Run) -> slice:
         raise LandingGearSimError(f"{run.name}: not a braking run (no current, or the wheel "
                                   "never touches the flywheel)")
     return slice(start, len(run))
+
+
+def stops(run: Run) -> list[Run]:
+    """The stops of a log, each from the end of the one before (its free rolling included)
+    to its brake's last command; the last to the end of the log. A rig test is one stop,
+    itself; a day's log of many is its stops (one hour of 227 stops was measured as one of
+    3598 s)."""
+    on = np.flatnonzero(run.current_a > BRAKE_ON_CURRENT_A)
+    ends = on[np.flatnonzero(np.diff(run.time_s[on]) > STOP_GAP_S)] if on.size else on
+    if ends.size == 0:
+        return [run]
+    bounds = [0, *(int(e) + 1 for e in ends), len(run)]
+    return [run.part(slice(a, b), f"{run.name} stop {k}")
+            for k, (a, b) in enumerate(itertools.pairwise(bounds), 1)]
 
 
 def speeds_m_s(run: Run, rig: RigParameters) -> tuple[np.ndarray, np.ndarray]:

@@ -48,6 +48,11 @@ class Run:
             raise RunFormatError(f"{self.source or self.name}: time must be strictly "
                                  "increasing with at least 2 samples")
 
+    def part(self, samples: slice, name: str) -> Run:
+        """The samples ``samples`` of this run, as the run ``name``."""
+        return Run(name=name, time_s=self.time_s[samples], source=self.source,
+                   notes=self.notes, **{s: getattr(self, s)[samples] for s in SIGNALS})
+
     @property
     def rate_hz(self) -> float:
         """Mean sample rate."""

@@ -151,3 +151,30 @@ def test_metrics_of_a_run_with_a_unit_mixed_up_names_the_unit(tmp_path, capsys, 
     assert main(["metrics", str(tmp_path / "run.csv")]) == 2
     error = capsys.readouterr().err
     assert fragment in error and "Traceback" not in error, error
+
+
+def test_metrics_of_a_log_of_several_stops_are_given_per_stop(tmp_path, capsys, reference):
+    """Issue 30: a one-hour log of 227 stops was measured as one 'stop' of 3598 s."""
+    import dataclasses
+
+    from msg_tools.csv_io import write_csv
+    from msg_tools.run import SIGNALS
+
+    alone = [simulate(reference, sc.constant_pressure_test(reference, bar * 1e5)).to_run(bar)
+             for bar in (20, 30, 40)]
+    step = alone[0].time_s[1] - alone[0].time_s[0]
+    starts = np.cumsum([0.0] + [r.time_s[-1] - r.time_s[0] + step for r in alone[:-1]])
+    log = dataclasses.replace(
+        alone[0], name="day", time_s=np.concatenate(
+            [r.time_s - r.time_s[0] + t0 for r, t0 in zip(alone, starts, strict=True)]),
+        **{s: np.concatenate([getattr(r, s) for r in alone]) for s in SIGNALS})
+    write_csv(log, tmp_path / "day.csv")
+    assert main(["metrics", str(tmp_path / "day.csv"), "--json", str(tmp_path / "m.json")]) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()
+            if line.startswith("day")]
+    assert [row[:3] for row in rows] == [["day", "stop", "1"], ["day", "stop", "2"],
+                                         ["day", "stop", "3"]]
+    written = json.loads((tmp_path / "m.json").read_text())
+    for stop, run in zip(written["stops"], alone, strict=True):
+        assert stop["stopping_time_s"] == pytest.approx(
+            braking_metrics(run, reference).stopping_time_s, abs=0.01)

@@ -225,7 +225,9 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
 
 
 def cmd_metrics(args: argparse.Namespace) -> int:
-    from antiskid.metrics import braking_metrics
+    import json
+
+    from antiskid.metrics import braking_metrics, stops
     from landing_gear_sim.calibration.plausibility import check_units
     from landing_gear_sim.calibration.runs import classify_all
     from landing_gear_sim.report.braking import metrics_table
@@ -233,11 +235,21 @@ def cmd_metrics(args: argparse.Namespace) -> int:
     check_outputs(files=[args.json, args.plot])
     rig = params_of(args)
     run = read_one(args.run, mapping_of(args))
+    parts = stops(run)
     # a unit within every range (a wheel in rpm: slip −7.8 accepted) named as identify does
-    check_units(classify_all([run]), rig)
-    metrics = braking_metrics(run, rig)
-    print(metrics_table({run.name: metrics}))
-    _write_braking_outputs(args, run, rig, metrics)
+    check_units(classify_all(parts), rig)
+    rows = {part.name: braking_metrics(part, rig) for part in parts}
+    print(metrics_table(rows))
+    if len(parts) == 1:
+        _write_braking_outputs(args, run, rig, rows[run.name])
+        return 0
+    if args.json:
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text(json.dumps({"stops": [{"name": name, **m.to_dict()}
+                                                   for name, m in rows.items()]}, indent=1))
+        print(f"  json: {args.json} ({len(parts)} stops)")
+    if args.plot:
+        print(f"  plot: not drawn for a log of {len(parts)} stops (cut the log to one stop)")
     return 0
 
 

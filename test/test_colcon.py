@@ -222,7 +222,10 @@ def test_ros2_tools_on_a_running_rig_a_second_rig_beside_it_and_ctrl_c(workspace
         code, value = _ros(workspace, _param("get", "/rig/plant friction.theta1"))
         assert code == 0 and "Double value is:" in value, value
         code, refused = _ros(workspace, _param("set", "/rig/plant friction.theta1 -1.0"))
-        assert "friction.theta1 must not be negative" in refused, refused
+        assert "read-only parameter: friction.theta1" in refused, refused
+        code, described = _ros(workspace, _param("describe", "/rig/plant friction.theta1"))
+        assert code == 0 and "Read only: true" in described and "Min value: 0.0" in described \
+            and "restart the node" in described, described
         code, second = _ros(workspace, "ros2 launch landing_gear_sim rig.launch.py "
                                        f"namespace:=rig2 params_file:={short_params} "
                                        f"bag:={tmp_path / 'second'}", timeout=300)

@@ -364,9 +364,19 @@ def test_a_running_node_answers_ros2_param_and_refuses_changes_with_the_reason(s
         assert call(client.get_parameters(["friction.theta1"])).values[0].double_value == 1.1
         bad, valid = (call(client.set_parameters([Parameter("friction.theta1", value=v)]))
                       .results[0] for v in (-1.0, 1.2))
-        assert not bad.successful and "friction.theta1 must not be negative" in bad.reason
-        assert not valid.successful and "read when the run starts" in valid.reason
+        assert not bad.successful and not valid.successful
+        assert "read-only" in bad.reason and "read-only" in valid.reason
         assert call(client.get_parameters(["friction.theta1"])).values[0].double_value == 1.1
+        # issue 31: the descriptors say what a value may be and that it is fixed for the run
+        theta1, timeout, priority, offset = call(client.describe_parameters(
+            ["friction.theta1", "timeout_s", "realtime_priority",
+             "sensors.pressure_offset_pa"])).descriptors
+        assert theta1.read_only and "restart the node" in theta1.additional_constraints
+        assert theta1.floating_point_range[0].from_value == 0.0
+        assert timeout.floating_point_range[0].from_value == 0.0
+        assert (priority.integer_range[0].from_value, priority.integer_range[0].to_value) == \
+            (0, 99)
+        assert offset.read_only and not offset.floating_point_range  # an offset has a sign
         node.destroy_node()
     finally:
         rclpy.shutdown(context=context)
@@ -390,6 +400,11 @@ def test_a_misspelt_parameter_stops_the_node_with_the_closest_name(tmp_path):
     assert recorder.stderr.strip().splitlines()[-1] == (
         "recorder: error: unknown parameter 'segmentt_s' (did you mean 'segment_s'?)")
     assert not (tmp_path / "bag").exists()  # refused before the bag folder is made
+    plant = run_command([sys.executable, "-m", "landing_gear_sim.ros.nodes.plant",
+                         "--ros-args", "-p", "friction.theta1:=-1.0"])
+    assert plant.returncode == 2 and "Traceback" not in plant.stderr, plant.stderr
+    assert plant.stderr.strip().splitlines()[-1].startswith(
+        "plant: error: friction.theta1 = -1.0 is out of its range [0, "), plant.stderr
 
 
 def test_two_rigs_share_a_domain_each_in_its_namespace(tmp_path, start):

@@ -10,9 +10,16 @@ from __future__ import annotations
 
 import difflib
 import math
+import sys
 from typing import Any
 
-from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from rcl_interfaces.msg import (
+    FloatingPointRange,
+    IntegerRange,
+    ParameterDescriptor,
+    SetParametersResult,
+)
+from rclpy.exceptions import InvalidParameterValueException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
@@ -28,11 +35,47 @@ from landing_gear_sim.model.runspec import RunSpec
 from landing_gear_sim.model.scenario import Scenario
 from landing_gear_sim.ros.graph import CLOCKS, load_scenario
 
+INT64 = (-(2 ** 63), 2 ** 63 - 1)
+FIXED_FOR_THE_RUN = ("read once, when the run starts: restart the node with -p {name}:=VALUE "
+                     "(or in its params file)")
 
-def declare(node: Node, name: str, default: Any, description: str) -> Any:
-    """Declare one parameter (any type a params file gives it) and return its value."""
-    descriptor = ParameterDescriptor(description=description, dynamic_typing=True)
-    return node.declare_parameter(name, default, descriptor).value
+
+def declare(node: Node, name: str, default: Any, description: str,
+            low: float | None = None, high: float | None = None) -> Any:
+    """Declare one parameter and return its value: read-only (the run reads it once), any
+    type a params file gives it (``1500`` for a double), within [``low``, ``high``] where
+    given (``ros2 param describe`` shows it; a value outside is a one-line error)."""
+    descriptor = ParameterDescriptor(description=description, dynamic_typing=True,
+                                     read_only=True,
+                                     additional_constraints=FIXED_FOR_THE_RUN.format(name=name))
+    if low is not None or high is not None:
+        _with_range(descriptor, default, low, high)
+    try:
+        return node.declare_parameter(name, default, descriptor).value
+    except InvalidParameterValueException:
+        given = _parameter_overrides(node).get(name)
+        value = given.value if given is not None else default
+        bounds = (f"{bound:g}" if bound is not None else sign + "inf"
+                  for bound, sign in ((low, "-"), (high, "")))
+        raise GraphError(f"{name} = {_as_text(value)} is out of its range "
+                         f"[{', '.join(bounds)}]") from None
+
+
+def _with_range(descriptor: ParameterDescriptor, default: Any, low: float | None,
+                high: float | None) -> None:
+    if isinstance(default, int) and not isinstance(default, bool):
+        descriptor.integer_range = [IntegerRange(
+            from_value=int(low if low is not None else INT64[0]),
+            to_value=int(high if high is not None else INT64[1]), step=0)]
+    else:
+        descriptor.floating_point_range = [FloatingPointRange(
+            from_value=float(low if low is not None else -sys.float_info.max),
+            to_value=float(high if high is not None else sys.float_info.max), step=0.0)]
+
+
+def _parameter_overrides(node: Node) -> dict[str, Parameter]:
+    """What ``-p`` and the params files gave ``node`` (rclpy keeps them only here)."""
+    return getattr(node, "_parameter_overrides", {})
 
 
 def rig_parameters(node: Node) -> RigParameters:
@@ -43,20 +86,23 @@ def rig_parameters(node: Node) -> RigParameters:
     """
     defaults = load_parameters()
     values = {spec.key: declare(node, spec.key, defaults[spec.key],
-                                f"{spec.description} [{spec.unit}]") for spec in SPECS}
+                                f"{spec.description} [{spec.unit}]",
+                                None if spec.kind != "float" or spec.signed else 0.0)
+              for spec in SPECS}
     return RigParameters(values, ("node parameters",))
 
 
-RUN_PARAMETERS: dict[str, tuple[Any, str]] = {
-    "run.profile": ("constant", "current profile"),
-    "run.pressure_pa": (RunSpec.pressure_pa, "constant profile pressure [Pa]"),
-    "run.current_a": (-1.0, "constant profile current [A]; <0: from run.pressure_pa"),
-    "run.file": ("", "file profile: run (CSV or bag)"),
-    "run.contact": ("auto", "auto | rig | actuator"),
-    "run.duration_s": (0.0, "input duration [s], 0: default"),
-    "run.rate_hz": (0.0, "exchange rate [Hz], 0: from config"),
+RUN_PARAMETERS: dict[str, tuple[Any, str, float | None]] = {
+    "run.profile": ("constant", "current profile", None),
+    "run.pressure_pa": (RunSpec.pressure_pa, "constant profile pressure [Pa]", 0.0),
+    "run.current_a": (-1.0, "constant profile current [A]; <0: from run.pressure_pa", None),
+    "run.file": ("", "file profile: run (CSV or bag)", None),
+    "run.contact": ("auto", "auto | rig | actuator", None),
+    "run.duration_s": (0.0, "input duration [s], 0: default", 0.0),
+    "run.rate_hz": (0.0, "exchange rate [Hz], 0: from config", 0.0),
 }
-"""The ``run.*`` parameters (see graph.run_parameters): name -> (default, description)."""
+"""The ``run.*`` parameters (see graph.run_parameters): name -> (default, description, the
+lowest value admitted)."""
 
 GRAPH_WIDE = frozenset(INDEX) | set(RUN_PARAMETERS) | {"clock", "parameter_services"}
 """Parameters a params file may give every node (``/**``): not an error for a node that has
@@ -65,8 +111,8 @@ no use for one (the recorder needs no friction curve)."""
 
 def run_spec(node: Node) -> RunSpec:
     """Declare the ``run.*`` parameters and build the RunSpec."""
-    value = {name: declare(node, name, default, text)
-             for name, (default, text) in RUN_PARAMETERS.items()}
+    value = {name: declare(node, name, default, text, low)
+             for name, (default, text, low) in RUN_PARAMETERS.items()}
     current = float(value["run.current_a"])
     return RunSpec(profile=str(value["run.profile"]), pressure_pa=float(value["run.pressure_pa"]),
                    current_a=current if current >= 0 else math.nan, file=str(value["run.file"]),
@@ -107,8 +153,7 @@ def check_overrides(node: Node) -> None:
     """
     if node.get_parameter("use_sim_time").value:
         raise GraphError(SIM_TIME_REFUSED)
-    # rclpy keeps the overrides of this node (its own and ``/**`` sections) only here
-    given = getattr(node, "_parameter_overrides", {})
+    given = _parameter_overrides(node)
     for name in sorted(given):
         if not (node.has_parameter(name) or name in GRAPH_WIDE):
             known = set(node.list_parameters([], 0).names) | GRAPH_WIDE

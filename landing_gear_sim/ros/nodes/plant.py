@@ -66,23 +66,25 @@ class PlantNode(GraphNode):
         super().__init__("plant")
         params, self._scenario, self._lockstep = rig_and_run(self)
         noise = declare(self, "sensor_noise", False, "add sensors.* noise to the outputs")
-        seed = int(declare(self, "noise_seed", 0, "seed of the sensor noise"))
+        seed = int(declare(self, "noise_seed", 0, "seed of the sensor noise", 0))
         self._timeout_s = float(declare(self, "timeout_s", 10.0,
-                                        "lockstep: wait this long for a peer, then hold its input"))
+                                        "lockstep: wait this long for a peer, then hold its input",
+                                        0.0))
         self._safe_pa = float(declare(self, "safe_pressure_pa", 0.0,
-                                      "brake pressure applied once the actuator is lost [Pa]"))
+                                      "brake pressure applied once the actuator is lost [Pa]",
+                                      0.0))
         self._participants = {str(p) for p in declare(
             self, "participants", [""], "nodes whose 'linked' message the run waits for; "
             "any other node that publishes commands is waited for through the graph") if p}
         self._start_timeout_s = float(declare(
             self, "start_timeout_s", 60.0, "give up (exit 4) when the run could not start "
-            "in this long [s]; 0: wait forever"))
+            "in this long [s]; 0: wait forever", 0.0))
         self._progress_s = float(declare(self, "progress_period_s", 5.0,
                                          "say how far the run is every this many seconds of "
-                                         "wall time [s]; 0: never"))
+                                         "wall time [s]; 0: never", 0.0))
         self._priority = int(declare(self, "realtime_priority", 10,
                                      "real time: SCHED_FIFO priority of the stepping thread "
-                                     "(1-99; 0: leave the scheduling alone)"))
+                                     "(1-99; 0: leave the scheduling alone)", 0, 99))
         # compile the step functions before the run: in real time the first samples do not
         # wait (the loading device's first force came ~0.6 s late, the wheel rolled unloaded)
         PlantBlock(params, self._scenario).advance(0.0, 0.0)

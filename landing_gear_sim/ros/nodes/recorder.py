@@ -56,9 +56,10 @@ class RecorderNode(GraphNode):
         path = str(declare(self, "bag", "", "rosbag2 folder to create"))
         storage = str(declare(self, "storage", "mcap", "mcap | sqlite3"))
         self._segment_ns = round(float(declare(self, "segment_s", 0.5, "sim time per closed "
-                                               "segment [s]: the most a crash loses")) * 1e9)
+                                               "segment [s]: the most a crash loses", 0.0))
+                                 * 1e9)
         self._segment_samples = int(declare(self, "segment_samples", 500,
-                                            "fewest samples per closed segment"))
+                                            "fewest samples per closed segment", 1))
         join = bool(declare(self, "join_segments", True, "join the segments into one file "
                             "when the bag closes (false: keep them)"))
         self._in_segment = 0

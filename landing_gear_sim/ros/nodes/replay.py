@@ -46,7 +46,8 @@ class ReplayNode(GraphNode):
         mode = str(declare(self, "topics", "all", "all | current"))
         path = str(declare(self, "file", "", "run to replay (CSV or bag)"))
         mapping = str(declare(self, "mapping", "", "column-mapping file for a CSV"))
-        self._speed = float(declare(self, "speed", 1.0, "topics=all: playback speed (x real time)"))
+        self._speed = float(declare(self, "speed", 1.0, "topics=all: playback speed (x real time)",
+                                    0.0))
         readers = int(declare(self, "wait_for_subscribers", 0,
                               "topics=all: start once every topic has this many readers"))
         if mode not in MODES:

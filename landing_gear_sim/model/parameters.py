@@ -404,15 +404,6 @@ def _check_values(values: Mapping[str, Any], origin: Mapping[str, str],
                              "parameter 'brake.fade_fraction' must be < 1")
 
 
-def spec_problem(key: str, value: Any) -> str | None:
-    """Why ``value`` is not admissible for the parameter ``key`` on its own, or None.
-
-    Raises:
-        KeyError: ``key`` is not a model parameter.
-    """
-    return _problem(_SPEC_BY_KEY[key], value)
-
-
 def _problem(spec: ParamSpec, value: Any) -> str | None:
     """Why ``value`` is not admissible for ``spec``, or None."""
     if spec.kind == "bool":

@@ -1,9 +1,10 @@
 """The parameters of a graph node: declared with descriptors, checked against what the
 node and the graph know, and read once, when the run is built.
 
-``ros2 param list/get/describe`` answer (see :func:`common.spin`); ``ros2 param set`` is
-refused with one reason (:func:`refuse_changes`); a name nothing reads stops the node with
-the closest known one (:func:`check_overrides`).
+``ros2 param list/get/describe`` answer (see :func:`common.spin`); every parameter is
+read-only, with its range where it has one (:func:`declare`), and ``ros2 param set`` on
+what rclpy declares itself is refused with the reason (:func:`refuse_changes`); a name
+nothing reads stops the node with the closest known one (:func:`check_overrides`).
 """
 
 from __future__ import annotations
@@ -29,7 +30,6 @@ from landing_gear_sim.model.parameters import (
     SPECS,
     RigParameters,
     load_parameters,
-    spec_problem,
 )
 from landing_gear_sim.model.runspec import RunSpec
 from landing_gear_sim.model.scenario import Scenario
@@ -163,29 +163,16 @@ def check_overrides(node: Node) -> None:
 
 
 def refuse_changes(node: Node, changes: list[Parameter]) -> SetParametersResult:
-    """``ros2 param set``: a node's parameters are read once, when its run is built, so a
-    change is refused, with the reason; a bad value is named as such first."""
+    """``ros2 param set`` on what rclpy declared itself (``use_sim_time``; the node's own
+    parameters are read-only, see :func:`declare`): refused too, with the reason, for a
+    node's run is built once."""
     if not changes:
         return SetParametersResult(successful=True)
     change = changes[0]
-    reason = _value_problem(node, change) or (
+    reason = SIM_TIME_REFUSED if change.name == "use_sim_time" and change.value else (
         f"{change.name} is read when the run starts; restart the node with "
         f"-p {change.name}:={_as_text(change.value)} (or in its params file)")
     return SetParametersResult(successful=False, reason=reason)
-
-
-def _value_problem(node: Node, change: Parameter) -> str | None:
-    if change.name == "use_sim_time" and change.value:
-        return SIM_TIME_REFUSED
-    if change.name in INDEX:
-        problem = spec_problem(change.name, change.value)
-        return f"{change.name} {problem}" if problem else None
-    current = node.get_parameter(change.name).value
-    if type(change.value) is not type(current) and not (
-            isinstance(current, float) and type(change.value) is int):
-        return (f"{change.name} must be a {type(current).__name__}, got "
-                f"{_as_text(change.value)}")
-    return None
 
 
 def _as_text(value: Any) -> str:

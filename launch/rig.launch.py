@@ -23,7 +23,8 @@ def _nodes(context):
     options, params_file = options_from_arguments(values)
     # the user's ROS_DOMAIN_ID and discovery settings reach the nodes untouched
     return [Node(package=PACKAGE, executable=node.name, name=node.name, output="screen",
-                 namespace=node.namespace, parameters=[str(params_file), node.parameters])
+                 namespace=node.namespace, parameters=[str(params_file), node.parameters],
+                 remappings=list(node.remappings))
             for node in describe(options)]
 
 

@@ -228,7 +228,8 @@ def test_ros2_tools_on_a_running_rig_a_second_rig_beside_it_and_ctrl_c(workspace
             and "restart the node" in described, described
         code, second = _ros(workspace, "ros2 launch landing_gear_sim rig.launch.py "
                                        f"namespace:=rig2 params_file:={short_params} "
-                                       f"bag:={tmp_path / 'second'}", timeout=300)
+                                       f"bag:={tmp_path / 'second'} clock_topic:=/rig2/clock",
+                            timeout=300)
         assert code == 0 and "bag closed" in second, second[-3000:]
         os.killpg(launch.pid, signal.SIGINT)
         output, _ = launch.communicate(timeout=60)

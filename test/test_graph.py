@@ -94,6 +94,19 @@ def test_an_external_controller_graph_has_no_command_node_and_a_start_timeout():
         GraphOptions(start_timeout_s=-1.0)
 
 
+def test_a_clock_topic_of_its_own_is_a_remapping_of_the_plants_clock(tmp_path):
+    """Issue 31: two namespaced lockstep rigs shared /clock; the option remaps the one
+    publisher of sim time, the same way from `rig` and from the launch file."""
+
+    options, _ = options_from_arguments({"namespace": "rig2", "clock_topic": "/rig2/clock"})
+    nodes = {n.name: n for n in describe(options)}
+    assert nodes["plant"].remappings == (("/clock", "/rig2/clock"),)
+    assert all(not n.remappings for name, n in nodes.items() if name != "plant")
+    command = node_command(nodes["plant"], tmp_path / "p.yaml")
+    assert command[command.index("/clock:=/rig2/clock") - 1] == "-r"
+    assert not describe(GraphOptions())[0].remappings  # /clock by default
+
+
 def test_without_a_bag_there_is_no_recorder_and_nobody_waits_for_one():
     nodes = {n.name: n for n in describe(GraphOptions())}
     assert "recorder" not in nodes

@@ -69,6 +69,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                      help="say how far the run is every S seconds (default 5; 0: never)")
     rig.add_argument("--namespace", default="rig",
                      help="namespace of the nodes and topics (default rig; a second rig: rig2)")
+    rig.add_argument("--clock-topic", default="/clock", metavar="TOPIC",
+                     help="topic the plant publishes sim time on (default /clock; a second "
+                     "lockstep rig: /rig2/clock, so each rig's sim-time listeners hear one "
+                     "clock)")
     rig.add_argument("--no-parameter-services", dest="parameter_services",
                      action="store_false", help="nodes answer no ros2 param (a little faster)")
     rig.set_defaults(func=cmd_rig, launcher=True)
@@ -192,7 +196,8 @@ def cmd_rig(args: argparse.Namespace) -> int:
                            safe_pressure_pa=args.safe_pressure_bar * PA_PER_BAR,
                            replay=args.replay is not None, controller=args.controller,
                            parameter_services=args.parameter_services,
-                           namespace=args.namespace.strip("/"), progress_s=args.progress)
+                           namespace=args.namespace.strip("/"), progress_s=args.progress,
+                           clock_topic=args.clock_topic)
     source = {None: scenario.name, "external": "your controller"}.get(
         args.controller, f"the {args.controller} controller")  # not "external: ..." (issue 32)
     progress(f"{source} in the {args.clock} graph, up to {scenario.duration_s:.1f} s at "

@@ -68,6 +68,8 @@ class NodeSpec:
     subscribes: tuple[str, ...]
     namespace: str = NAMESPACE
     """Where the node and its (relative) topics live: ``rig`` → ``/rig/brake/pressure``."""
+    remappings: tuple[tuple[str, str], ...] = ()
+    """ROS remapping rules (``-r FROM:=TO``), e.g. the plant's ``/clock`` onto a rig's own."""
 
     @property
     def module(self) -> str:
@@ -101,6 +103,9 @@ class GraphOptions:
         parameter_services: the nodes answer ``ros2 param`` (off: the bench's comparison).
         namespace: the rig's namespace (``rig``); a second rig on the same domain takes
             another (``rig2``) and keeps to its own topics.
+        clock_topic: where the plant publishes sim time (``/clock``): two lockstep rigs on
+            one domain each take their own (``/rig2/clock``), so that a sim-time listener
+            of one hears one clock.
     """
     # a controller graph is a rig test braking from rig_test.brake_start_s: run.profile
     # is "external" (see controlled_run)
@@ -118,6 +123,7 @@ class GraphOptions:
     replay: bool = False
     parameter_services: bool = True
     namespace: str = NAMESPACE
+    clock_topic: str = TOPIC_CLOCK
 
     def __post_init__(self) -> None:
         if not NAMESPACE_PATTERN.fullmatch(self.namespace):
@@ -149,6 +155,8 @@ LAUNCH_ARGUMENTS: dict[str, tuple[str, str]] = {
                    "external (your own node publishes the commands)"),
     "namespace": (NAMESPACE, "namespace of the rig's nodes and topics (a second rig: rig2)"),
     "progress_s": ("5", "the plant says how far the run is every this many seconds; 0: never"),
+    "clock_topic": (TOPIC_CLOCK, "topic the plant publishes sim time on (a second lockstep "
+                    "rig: /rig2/clock, so each rig's sim-time listeners hear one clock)"),
 }
 """Launch-file arguments: name -> (default, description)."""
 
@@ -190,7 +198,7 @@ def options_from_arguments(values: dict[str, str]) -> tuple[GraphOptions, Path]:
     options = GraphOptions(run=run, clock=value("clock"), storage=value("storage"),
                            bag=Path(value("bag")) if value("bag") else None,
                            controller=controller, namespace=value("namespace").strip("/"),
-                           progress_s=number("progress_s"))
+                           progress_s=number("progress_s"), clock_topic=value("clock_topic"))
     return options, Path(value("params_file") or default_config_files()[0])
 
 
@@ -233,7 +241,10 @@ def describe(options: GraphOptions) -> list[NodeSpec]:
         nodes.append(NodeSpec("recorder", {**shared, "bag": str(options.bag),
                                            "storage": options.storage},
                               (), RECORDED_TOPICS))
-    return [replace(node, namespace=options.namespace) for node in _with_links(nodes)]
+    clock = ((TOPIC_CLOCK, options.clock_topic),) if options.clock_topic != TOPIC_CLOCK else ()
+    return [replace(node, namespace=options.namespace,
+                    remappings=clock if node.name == "plant" else ())
+            for node in _with_links(nodes)]
 
 
 def _with_links(nodes: list[NodeSpec]) -> list[NodeSpec]:

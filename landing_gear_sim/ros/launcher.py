@@ -53,8 +53,9 @@ def node_command(node: NodeSpec, params_file: Path, python: str = sys.executable
     """The command line that runs ``node`` with the graph's params file."""
     overrides = [arg for name, value in node.parameters.items()
                  for arg in ("-p", f"{name}:={format_value(value)}")]
+    remaps = [arg for rule in node.remappings for arg in ("-r", ":=".join(rule))]
     return [python, "-m", node.module, "--ros-args", "-r", f"__ns:=/{node.namespace}",
-            "--params-file", str(params_file), *overrides]
+            *remaps, "--params-file", str(params_file), *overrides]
 
 
 @dataclass

@@ -18,7 +18,7 @@ from collections.abc import Callable, Sequence
 
 from landing_gear_sim import __version__
 from landing_gear_sim.cli import analysis, fleet, model, montecarlo
-from landing_gear_sim.cli.common import PROG
+from landing_gear_sim.cli.common import PROG, check_inputs
 from landing_gear_sim.errors import LandingGearSimError
 
 
@@ -74,6 +74,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _run(args: argparse.Namespace) -> int:
     try:
+        check_inputs(args)
         return int(args.func(args))
     except LandingGearSimError as exc:
         print(f"{PROG}: error: {exc}", file=sys.stderr)

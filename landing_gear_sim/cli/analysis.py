@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from landing_gear_sim.cli.common import (
+    InputPath,
     add_params_arguments,
     check_outputs,
     mapping_of,
@@ -30,35 +31,35 @@ if TYPE_CHECKING:
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the sub-commands of this module to the ``landing-gear-sim`` parser."""
     ident = sub.add_parser("identify", help="calibrate the model on a campaign folder")
-    ident.add_argument("campaign", type=Path, help="folder of runs (CSV files, bags)")
+    ident.add_argument("campaign", type=InputPath, help="folder of runs (CSV files, bags)")
     add_params_arguments(ident)
     ident.add_argument("-o", "--output", type=Path, default=Path("out/calibrated.yaml"),
                        help="calibrated params file (default out/calibrated.yaml)")
     ident.add_argument("--fix-theta3", action="store_true", help="keep Burckhardt theta3")
-    ident.add_argument("--mapping", type=Path, help="column-mapping file for the CSVs")
+    ident.add_argument("--mapping", type=InputPath, help="column-mapping file for the CSVs")
     ident.add_argument("--partial", action="store_true",
                        help="write the parameters a campaign could identify even when a step "
                        "was skipped or failed (the file lists what kept its base value)")
     ident.set_defaults(func=cmd_identify)
 
     val = sub.add_parser("validate", help="simulate a campaign with its inputs; fit report")
-    val.add_argument("campaign", type=Path, help="folder of runs (CSV files, bags)")
+    val.add_argument("campaign", type=InputPath, help="folder of runs (CSV files, bags)")
     add_params_arguments(val)
     val.add_argument("--report", type=Path, default=Path("out/validation"),
                      help="folder of the HTML fit report (default out/validation)")
-    val.add_argument("--mapping", type=Path, help="column-mapping file for the CSVs")
+    val.add_argument("--mapping", type=InputPath, help="column-mapping file for the CSVs")
     val.set_defaults(func=cmd_validate)
 
     cmp_ = sub.add_parser("compare", help="fit per channel of a simulated vs a measured run")
-    cmp_.add_argument("measured", type=Path, help="the rig's run (CSV or bag)")
-    cmp_.add_argument("simulated", type=Path, help="the model's run of the same input")
+    cmp_.add_argument("measured", type=InputPath, help="the rig's run (CSV or bag)")
+    cmp_.add_argument("simulated", type=InputPath, help="the model's run of the same input")
     cmp_.add_argument("--plot", type=Path, default=Path("out/compare.png"),
                       help="PNG path (default out/compare.png)")
-    cmp_.add_argument("--mapping", type=Path, help="column-mapping file for MEASURED")
+    cmp_.add_argument("--mapping", type=InputPath, help="column-mapping file for MEASURED")
     cmp_.set_defaults(func=cmd_compare)
 
     diag = sub.add_parser("diagnose", help="why model and rig disagree: cause, extension, gain")
-    diag.add_argument("runs", type=Path, nargs="+", metavar="RUN",
+    diag.add_argument("runs", type=InputPath, nargs="+", metavar="RUN",
                       help="CSV files, bags, or campaign folders")
     add_params_arguments(diag, without=False)
     diag.add_argument("--without", action="extend", type=_names, default=[],
@@ -69,13 +70,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     diag.add_argument("--json", type=Path, help="write the diagnosis contract JSON here")
     diag.add_argument("--report", type=Path, help="write the HTML report into this folder")
     diag.add_argument("-o", "--output", type=Path, help="write the extended model (params)")
-    diag.add_argument("--mapping", type=Path, help="column-mapping file for the CSVs")
+    diag.add_argument("--mapping", type=InputPath, help="column-mapping file for the CSVs")
     diag.set_defaults(func=cmd_diagnose)
 
     met = sub.add_parser("metrics", help="braking metrics of a run (efficiency, locks, ...)")
-    met.add_argument("run", type=Path, help="CSV or bag of a braking run")
+    met.add_argument("run", type=InputPath, help="CSV or bag of a braking run")
     add_params_arguments(met)
-    met.add_argument("--mapping", type=Path, help="column-mapping file for a CSV")
+    met.add_argument("--mapping", type=InputPath, help="column-mapping file for a CSV")
     met.add_argument("--plot", type=Path, help="PNG like the paper's Fig. 1")
     met.add_argument("--json", type=Path, help="write the metrics as JSON")
     met.set_defaults(func=cmd_metrics)

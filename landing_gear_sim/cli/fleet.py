@@ -7,14 +7,20 @@ import json
 from pathlib import Path
 from typing import Any
 
-from landing_gear_sim.cli.common import add_params_arguments, check_outputs, params_of, progress
+from landing_gear_sim.cli.common import (
+    InputPath,
+    add_params_arguments,
+    check_outputs,
+    params_of,
+    progress,
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the sub-commands of this module to the ``landing-gear-sim`` parser."""
     hist = sub.add_parser("history", help="identify and diagnose many campaigns (Dask); "
                           "parameter table, trends and steps over time")
-    hist.add_argument("campaigns", type=Path, nargs="+", metavar="CAMPAIGN",
+    hist.add_argument("campaigns", type=InputPath, nargs="+", metavar="CAMPAIGN",
                       help="campaign folders, or folders of campaigns (one per sub-folder); "
                       "time order is the order of the folder names")
     add_params_arguments(hist, without=False)

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 from landing_gear_sim.cli.common import (
     PROG,
+    InputPath,
     add_params_arguments,
     add_run_arguments,
     add_storage_argument,
@@ -112,10 +113,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     gen.set_defaults(func=cmd_campaign)
 
     conv = sub.add_parser("convert", help="convert a run between CSV and rosbag2")
-    conv.add_argument("input", type=Path, help="a run: CSV, bag folder or another format")
+    conv.add_argument("input", type=InputPath, help="a run: CSV, bag folder or another format")
     conv.add_argument("output", type=Path, help="*.csv, or a bag folder")
     add_storage_argument(conv)
-    conv.add_argument("--mapping", type=Path, help="column-mapping file for a CSV input")
+    conv.add_argument("--mapping", type=InputPath, help="column-mapping file for a CSV input")
     conv.set_defaults(func=cmd_convert)
 
 

@@ -10,6 +10,7 @@ to 10 ms. CSV -> bag -> CSV gives back the same text.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -19,7 +20,7 @@ from .contract import CSV_COLUMNS, CSV_SCALE_TO_SI, CSV_TO_FIELD
 from .mapping import DEFAULT_MAPPING, Mapping
 from .mapping import read_mapping as read_mapping
 from .run import Run
-from .text_table import read_table, read_text
+from .text_table import Table, read_table, read_text
 
 TIME_FORMAT = ".6f"  # 1 µs, absolute epoch times included (float64 resolves 0.24 µs there)
 VALUE_FORMAT = ".12g"
@@ -34,9 +35,16 @@ def read_csv(path: Path, name: str | None = None, mapping: Mapping | None = None
             values, time not strictly increasing; the message names the file.
     """
     path = Path(path)
+    return read_named(path, lambda wanted, text: read_table(read_text(path), wanted, str(path),
+                                                            text), name, mapping)
+
+
+def read_named(path: Path, table_of: Callable[[list[str], list[str]], Table],
+               name: str | None = None, mapping: Mapping | None = None) -> Run:
+    """The run of ``path`` whose table ``table_of`` reads, given the columns it must find
+    and those read as text (a delimited text file, a workbook's sheet)."""
     mapping = mapping or DEFAULT_MAPPING
-    table = read_table(read_text(path), wanted_columns(mapping), str(path),
-                       text_columns(mapping))
+    table = table_of(wanted_columns(mapping), text_columns(mapping))
     return run_from_table(table, str(path), name or run_name(path), mapping)
 
 

@@ -10,10 +10,10 @@ import numpy as np
 
 from .bag_read import STORAGE_SUFFIXES, read_bag, storage_files
 from .binary_tables import READERS
-from .columns import run_from_table, text_columns, wanted_columns
-from .csv_io import read_csv, run_name
+from .columns import run_from_table
+from .csv_io import read_csv, read_named, run_name
 from .errors import RunFormatError
-from .mapping import DEFAULT_MAPPING, Mapping
+from .mapping import Mapping
 from .run import Run
 from .timebase import split_at_gaps
 from .workbook import SUFFIXES as WORKBOOK_SUFFIXES
@@ -70,9 +70,8 @@ def read_run(path: Path, mapping: Mapping | None = None, name: str | None = None
     if kind == "text":
         return read_csv(path, name, mapping)
     if kind == "workbook":
-        mapping = mapping or DEFAULT_MAPPING
-        table = read_workbook(path, wanted_columns(mapping), text_columns(mapping))
-        return run_from_table(table, str(path), name or run_name(path), mapping)
+        return read_named(path, lambda wanted, text: read_workbook(path, wanted, text), name,
+                          mapping)
     if kind == "binary":
         table = READERS[path.suffix.lower()](path)
         return run_from_table(table, str(path), name or run_name(path), mapping)

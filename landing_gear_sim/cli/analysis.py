@@ -226,8 +226,6 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
 
 
 def cmd_metrics(args: argparse.Namespace) -> int:
-    import json
-
     from antiskid.metrics import braking_metrics, stops
     from landing_gear_sim.calibration.plausibility import check_units
     from landing_gear_sim.calibration.runs import classify_all
@@ -245,9 +243,8 @@ def cmd_metrics(args: argparse.Namespace) -> int:
         _write_braking_outputs(args, run, rig, rows[run.name])
         return 0
     if args.json:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(json.dumps({"stops": [{"name": name, **m.to_dict()}
-                                                   for name, m in rows.items()]}, indent=1))
+        _write_json(args.json, {"stops": [{"name": name, **m.to_dict()}
+                                          for name, m in rows.items()]})
         print(f"  json: {args.json} ({len(parts)} stops)")
     if args.plot:
         print(f"  plot: not drawn for a log of {len(parts)} stops (cut the log to one stop)")
@@ -290,16 +287,19 @@ def cmd_antiskid(args: argparse.Namespace) -> int:
     return 0
 
 
-def _write_braking_outputs(args: argparse.Namespace, run: Run, rig: RigParameters,
-                           metrics: BrakingMetrics, default_plot: Path | None = None) -> None:
+def _write_json(path: Path, document: object) -> None:
     import json
 
+    write_atomically(path, lambda p: p.write_text(json.dumps(document, indent=1)))
+
+
+def _write_braking_outputs(args: argparse.Namespace, run: Run, rig: RigParameters,
+                           metrics: BrakingMetrics, default_plot: Path | None = None) -> None:
     from antiskid.metrics import slip_from, speeds_m_s
     from landing_gear_sim.report.braking import plot_braking
 
     if args.json:
-        args.json.parent.mkdir(parents=True, exist_ok=True)
-        args.json.write_text(json.dumps(metrics.to_dict(), indent=1))
+        _write_json(args.json, metrics.to_dict())
         print(f"  json: {args.json}")
     plot = args.plot or default_plot
     if plot is not None:

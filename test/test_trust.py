@@ -28,6 +28,7 @@ from landing_gear_sim.diagnosis.diagnose import diagnose
 from landing_gear_sim.diagnosis.equations import Equation, EquationError, locate
 from landing_gear_sim.diagnosis.families import HIDDEN, Evidence, gain_law
 from landing_gear_sim.diagnosis.findings import Signature, SignatureKind
+from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, score_candidate
 from landing_gear_sim.diagnosis.signatures import find_signatures, unexplained
 from landing_gear_sim.errors import ParameterError
@@ -283,6 +284,54 @@ def test_a_wheel_channel_skew_read_through_a_counting_encoder_is_discovered(refe
     assert result.findings[0].parameters["wheel_speed_delay_s"] == pytest.approx(
         rig.number("sensors.wheel_speed_delay_s"), abs=1e-3)
     assert result.findings[0].held_out is not None and result.findings[0].held_out < -10
+
+
+def test_a_wheel_channel_skew_read_through_a_64_line_encoder_is_discovered(reference,
+                                                                          tmp_path):
+    """A wheel channel logged late through a 64-line encoder (98 rad/s per count; the skew
+    drawn by the test): the stops at constant pressure decelerate smoothly, so their
+    counted speed holds no timing, and read 0.0 ms or ±14 ms; outvoting the cycling stops
+    (21 and 10 ms), they left no lag, no candidate and the verdict 'none'. Only a stop
+    whose transitions stand out of the counting noise tells a channel's timing."""
+    runs, rig = _campaign(reference, tmp_path, 1222, lambda rng: {
+        "sensors.wheel_speed_delay_s": rng.uniform(0.01, 0.025)},
+        logger=Logger(encoder_counts=64), names=None)
+    result = _consistent(diagnose(runs, reference))
+    assert [(f.cause, f.family) for f in result.findings[:1]] == [
+        ("discovered", "channel_skew")], [(f.cause, f.family, f.evidence)
+                                          for f in result.candidates]
+    assert result.findings[0].parameters["wheel_speed_delay_s"] == pytest.approx(
+        rig.number("sensors.wheel_speed_delay_s"), abs=1.5e-3)
+
+
+def _ripple_resolution(problems):
+    [note] = [p for p in problems if p.startswith(f"{Relation.WHEEL_ANGLE}: ")]
+    return float(note.split(" below ")[1].split(" %")[0]) / 100
+
+
+def test_a_counted_wheel_channel_says_which_ripple_it_cannot_resolve(reference, tmp_path):
+    """A ripple twice per revolution (0.64 % of ω) read through a 64-line encoder at 2 kHz
+    (196 rad/s per count): its free-rolling checks read 0.48-0.85 % ± 0.45 % per run, so
+    the verdict 'none' was all a user saw. The notes say what the channel cannot resolve;
+    a ripple of twice that size, in the same campaign, is found."""
+    logger = Logger(rate_hz=2000.0, encoder_counts=64)
+    small, _ = _campaign(reference, tmp_path / "small", 1188, lambda rng: {
+        "sensors.wheel_runout_2": rng.uniform(0.003, 0.008),
+        "sensors.wheel_runout_2_phase_rad": rng.uniform(-np.pi, np.pi)},
+        logger=logger, names=None)
+    result = _consistent(diagnose(small, reference))
+    assert result.verdict == "none", [f.evidence for f in result.findings]
+    bound = _ripple_resolution(result.problems)
+    assert 0.008 < bound < 0.05
+    large, rig = _campaign(reference, tmp_path / "large", 1188, lambda rng: {
+        "sensors.wheel_runout_2": 2 * bound * rng.uniform(1.0, 1.2),
+        "sensors.wheel_runout_2_phase_rad": rng.uniform(-np.pi, np.pi)},
+        logger=logger, names=None)
+    found = _consistent(diagnose(large, reference))
+    assert (found.verdict, found.findings[0].family) == ("discovered", "wheel_angle"), \
+        [(f.cause, f.family, f.evidence) for f in found.candidates]
+    assert found.findings[0].parameters["wheel_runout_2"] == pytest.approx(
+        rig.number("sensors.wheel_runout_2"), rel=0.2)
 
 
 def test_a_discovered_term_never_fits_worse_than_the_model_without_it(reference, tmp_path):

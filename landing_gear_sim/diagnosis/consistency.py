@@ -34,6 +34,7 @@ import numpy as np
 import scipy.signal
 
 from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration.plausibility import lattice_step
 from landing_gear_sim.calibration.runs import ClassifiedRun, RunKind
 from landing_gear_sim.calibration.statistics import (
     inverse_variance_weights,
@@ -51,7 +52,13 @@ from landing_gear_sim.diagnosis.load_relation import (
     LOAD_SPREAD,
     friction_in_load,
 )
-from landing_gear_sim.diagnosis.relations import MIN_CHECK_S, MIN_SAMPLES, Check, Relation
+from landing_gear_sim.diagnosis.relations import (
+    MIN_CHECK_S,
+    MIN_SAMPLES,
+    Z_VIOLATED,
+    Check,
+    Relation,
+)
 from landing_gear_sim.diagnosis.scoring import effective_count
 from landing_gear_sim.model.actuator import actuator_pressure
 from landing_gear_sim.model.parameters import RigParameters
@@ -115,6 +122,22 @@ def unchecked_relations(runs: Sequence[ClassifiedRun], checks: Sequence[Check]) 
             f"static loads ≥ {LOAD_SPREAD:.0%} apart that share slips; stops at a second static "
             "load (e.g. 70 % at 70 % of the pressures: `campaign --light-runs`) show a tyre's "
             "friction changing with the load"]
+
+
+def coarse_channels(runs: Sequence[ClassifiedRun], checks: Sequence[Check]) -> list[str]:
+    """What a counted wheel channel cannot resolve (for ``problems``: a ``none`` through a
+    coarse encoder is no proof of a smooth wheel): the smallest ripple with the wheel's angle
+    a run's free-rolling check would call violated, Z_VIOLATED of its σ (median over runs)."""
+    braking = [r for r in runs if r.braking]
+    if not braking or any(lattice_step(r.wheel_speed_rad_s) is None for r in braking):
+        return []
+    stds = [c.std for c in checks if c.relation == WHEEL_ANGLE]
+    if not stds:
+        return []
+    bound = max(Z_VIOLATED * float(np.median(stds)), RUNOUT_FLOOR)
+    return [f"{WHEEL_ANGLE}: through the counted wheel channel a ripple below "
+            f"{100 * bound:.1f} % of ω does not show ({Z_VIOLATED:g}σ of the free-rolling "
+            f"checks, median over {len(stds)})"]
 
 
 def inconsistent(broken: Sequence[Check]) -> Finding:

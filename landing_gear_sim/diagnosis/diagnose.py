@@ -33,6 +33,7 @@ from landing_gear_sim.diagnosis.catalogue import (
 )
 from landing_gear_sim.diagnosis.consistency import (
     check_campaign,
+    coarse_channels,
     inconsistent,
     unchecked_relations,
 )
@@ -167,6 +168,7 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     checks = check_campaign(runs, model)
     calibrated_checks = checks if model is calibrated else check_campaign(runs, calibrated)
     problems.extend(unchecked_relations(runs, calibrated_checks))
+    problems.extend(coarse_channels(runs, calibrated_checks))
     story = discovered.Story(runs, calibrated, base, scales, tried, calibrated_checks, say)
     found = story.extend(accepted, model, checks)
     if found is not None:

@@ -38,6 +38,11 @@ CORRELATION_BANDS = 3.0  # ... and that many times its noise band
 LINE_BAND_HZ = (2.0, 200.0)
 MIN_SPECTRUM_SAMPLES = 2048  # one Welch segment: a shorter window shows no line
 LAG_PRESSURE_SPAN_PA = 5 * PA_PER_BAR  # a run whose pressure moves this much shows a lag
+# ... and a run shows its timing where the model's transitions (sample to sample) stand out
+# of the channel's noise there: rms over the error's std; a 64-line encoder's stops at
+# constant pressure read 0.006-0.03 (lags of 0.0 or ±14 ms for a 20 ms skew), its cycling
+# stops 0.35-1.0
+TIMING_SNR = 0.2
 
 
 def _regressors(run: Run, model: Run, params: RigParameters) -> dict[str, np.ndarray]:
@@ -110,10 +115,11 @@ def find_signatures(runs: Sequence[ClassifiedRun], params: RigParameters,
                                                     _regressors(run, model, params).items()}):
                     correlations.setdefault(c.name, []).append((run.name, c.value, c.band))
         for channel, timed in _timed_channels(run, window).items():
-            read, predicted = (_timing(getattr(x, channel), channel, run.rate_hz)
+            read, predicted = (_timing(getattr(x, channel), channel, run.rate_hz)[timed]
                                for x in (run, model))
-            lags.setdefault(channel, []).append(
-                (run.name, rs.lag_samples(read[timed], predicted[timed], 50) / run.rate_hz))
+            if _shows_timing(read, predicted):
+                lags.setdefault(channel, []).append(
+                    (run.name, rs.lag_samples(read, predicted, 50) / run.rate_hz))
     found = [*_recurring_lines(lines),
              *(s for channel, found in lags.items() for s in _consistent_lag(channel, found, runs)),
              *_consistent_correlations(correlations)]
@@ -128,6 +134,13 @@ def _timing(values: np.ndarray, channel: str, rate_hz: float) -> np.ndarray:
     if channel != "wheel_speed_rad_s":
         return values
     return br.lowpass(values, rate_hz, min(TIMING_FILTER_HZ, 0.4 * rate_hz))
+
+
+def _shows_timing(read: np.ndarray, predicted: np.ndarray) -> bool:
+    """Whether the model's transitions stand out of the channel's noise (TIMING_SNR)."""
+    transitions = np.diff(predicted)
+    noise = float(np.std(np.diff(read) - transitions))
+    return float(np.sqrt(np.mean(transitions**2))) >= TIMING_SNR * noise
 
 
 def _timed_channels(run: ClassifiedRun, window: np.ndarray) -> dict[str, np.ndarray]:

@@ -13,6 +13,7 @@ import pytest
 import yaml
 from rosbags.rosbag2 import Reader
 
+from landing_gear_sim.cli.common import run_spec_of
 from landing_gear_sim.errors import GraphError, LandingGearSimError
 from landing_gear_sim.model.blocks import ActuatorBlock, LoadingBlock, PlantBlock
 from landing_gear_sim.model.integrate import simulate
@@ -29,6 +30,7 @@ from landing_gear_sim.ros.graph import (
     options_from_arguments,
 )
 from landing_gear_sim.ros.launcher import format_value, node_command, ros_environment
+from landing_gear_sim.ros.options import GRAPH_OPTIONS, OPTIONS, given, graph_settings
 from msg_tools.bag_io import TYPESTORE
 from msg_tools.bag_read import read_bag
 from msg_tools.bag_segments import OPEN_SEGMENT, SegmentedBagWriter
@@ -179,6 +181,42 @@ def test_launch_arguments_become_graph_options(tmp_path):
     assert controlled.run.profile == "external" and controlled.controller == "slip"
     with pytest.raises(LandingGearSimError, match="clock"):
         options_from_arguments({"clock": "fast"})
+
+
+# a value other than the default for every option of a session, as a user types it both ways
+NOT_DEFAULT = {"clock": ("realtime", "realtime"), "controller": ("slip", "slip"),
+               "storage": ("sqlite3", "sqlite3"), "noise": ("--noise", "true"),
+               "timeout_s": ("2.5", "2.5"), "start_timeout_s": ("0", "0"),
+               "safe_pressure_bar": ("3", "3"), "progress_s": ("0", "0"),
+               "namespace": ("lab/rig2", "/lab/rig2"),
+               "clock_topic": ("/rig2/clock", "/rig2/clock"),
+               "parameter_services": ("--no-parameter-services", "false")}
+
+
+def test_rig_and_the_launch_file_offer_the_same_options_to_the_same_effect(tmp_path):
+    """The launch file offered part of ``rig`` (no timeouts, noise, safe pressure, rate):
+    both now come from one table, and each option set either way gives one graph."""
+    from landing_gear_sim.cli import build_parser
+
+    assert set(NOT_DEFAULT) == {o.name for o in GRAPH_OPTIONS}
+    assert {o.name for o in GRAPH_OPTIONS} | {"rate_hz"} <= set(LAUNCH_ARGUMENTS)
+    for name, (flag_value, launch_value) in NOT_DEFAULT.items():
+        option = OPTIONS[name]
+        argv = [flag_value] if flag_value.startswith("--") else [option.option, flag_value]
+        args = build_parser().parse_args(["rig", "--no-bag", "--rate", "500", *argv])
+        cli = GraphOptions(run=controlled_run(run_spec_of(args), args.controller),
+                           **graph_settings(given(args)))
+        launched, _ = options_from_arguments({"profile": "constant", "pressure_bar": "30",
+                                              "rate_hz": "500", name: launch_value})
+        assert cli == launched, name
+        assert cli != GraphOptions(run=cli.run), name  # the option changed something
+
+
+def test_a_launch_argument_of_the_wrong_type_is_one_clear_error():
+    with pytest.raises(GraphError, match="noise must be true or false, got 'maybe'"):
+        options_from_arguments({"noise": "maybe"})
+    with pytest.raises(GraphError, match="timeout_s must be a number"):
+        options_from_arguments({"timeout_s": "soon"})
 
 
 def test_launch_file_starts_exactly_the_described_nodes(monkeypatch, tmp_path):

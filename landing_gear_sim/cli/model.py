@@ -25,6 +25,7 @@ from landing_gear_sim.cli.common import (
 from landing_gear_sim.errors import LandingGearSimError
 from landing_gear_sim.model.parameters import SPECS
 from landing_gear_sim.model.runspec import RunSpec
+from landing_gear_sim.ros.options import add_graph_arguments
 from msg_tools.units import PA_PER_BAR
 
 if TYPE_CHECKING:
@@ -49,33 +50,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_run_arguments(rig)
     rig.add_argument("--replay", type=Path, metavar="RUN",
                      help="re-run a recorded rig test: its current drives the simulated graph")
-    rig.add_argument("--controller", choices=["threshold", "slip", "external"],
-                     help="anti-skid controller in closed loop instead of a profile; "
-                     "external: your own node publishes the brake commands (see "
-                     "examples/outside_controller.py; the run waits for it)")
-    rig.add_argument("--clock", choices=["lockstep", "realtime"], default="lockstep",
-                     help="lockstep: sim time, deterministic (default); realtime: wall clock")
     rig.add_argument("--bag", type=Path, help="bag folder (default out/rig/<run>_<time>)")
     rig.add_argument("--no-bag", action="store_true", help="run without the recorder")
-    add_storage_argument(rig)
-    rig.add_argument("--noise", action="store_true", help="add the sensors.* noise")
-    rig.add_argument("--timeout", type=float, default=10.0,
-                     help="lockstep: seconds to wait for a silent node before holding its input")
-    rig.add_argument("--start-timeout", type=float, default=60.0,
-                     help="seconds to wait for every participant (an external controller) "
-                     "before giving up with an error; 0: wait forever")
-    rig.add_argument("--safe-pressure-bar", type=float, default=0.0,
-                     help="brake pressure applied once the actuator is lost (default 0)")
-    rig.add_argument("--progress", type=float, default=5.0, metavar="S",
-                     help="say how far the run is every S seconds (default 5; 0: never)")
-    rig.add_argument("--namespace", default="rig",
-                     help="namespace of the nodes and topics (default rig; a second rig: rig2)")
-    rig.add_argument("--clock-topic", default="/clock", metavar="TOPIC",
-                     help="topic the plant publishes sim time on (default /clock; a second "
-                     "lockstep rig: /rig2/clock, so each rig's sim-time listeners hear one "
-                     "clock)")
-    rig.add_argument("--no-parameter-services", dest="parameter_services",
-                     action="store_false", help="nodes answer no ros2 param (a little faster)")
+    add_graph_arguments(rig)  # the launch file's arguments too
     rig.set_defaults(func=cmd_rig, launcher=True)
 
     bode = sub.add_parser("bode", help="frequency responses G_lambda, G_eta (paper Fig. 7)")
@@ -179,6 +156,7 @@ def cmd_rig(args: argparse.Namespace) -> int:
         load_scenario,
     )
     from landing_gear_sim.ros.launcher import run_graph
+    from landing_gear_sim.ros.options import given, graph_settings
 
     params = params_of(args)
     spec = run_spec_of(args)
@@ -191,14 +169,8 @@ def cmd_rig(args: argparse.Namespace) -> int:
         f"{scenario.name}_{time.strftime('%Y%m%d-%H%M%S')}")
     if bag is not None and bag.exists():
         raise LandingGearSimError(f"{bag}: exists already; remove it or choose another --bag")
-    options = GraphOptions(run=spec, clock=args.clock, bag=bag, storage=args.storage,
-                           sensor_noise=args.noise, timeout_s=args.timeout,
-                           start_timeout_s=args.start_timeout,
-                           safe_pressure_pa=args.safe_pressure_bar * PA_PER_BAR,
-                           replay=args.replay is not None, controller=args.controller,
-                           parameter_services=args.parameter_services,
-                           namespace=args.namespace.strip("/"), progress_s=args.progress,
-                           clock_topic=args.clock_topic)
+    options = GraphOptions(run=spec, bag=bag, replay=args.replay is not None,
+                           **graph_settings(given(args)))
     source = {None: scenario.name, "external": "your controller"}.get(
         args.controller, f"the {args.controller} controller")  # not "external: ..." (issue 32)
     progress(f"{source} in the {args.clock} graph, up to {scenario.duration_s:.1f} s at "

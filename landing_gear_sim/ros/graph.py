@@ -17,6 +17,14 @@ from landing_gear_sim.errors import GraphError
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.runspec import RunSpec, build_scenario
 from landing_gear_sim.model.scenario import Scenario
+from landing_gear_sim.ros.options import (
+    CLOCKS,
+    GRAPH_OPTIONS,
+    STORAGES,
+    TOPIC_CLOCK,
+    default,
+    graph_settings,
+)
 from msg_tools.contract import (
     NAMESPACE,
     TOPIC_CURRENT,
@@ -38,7 +46,6 @@ TOPIC_RUN_END = "/rig/run_end"
 """Plant → everyone: the run is over; data = number of samples (std_msgs/UInt64, latched)."""
 TOPIC_READY = "/rig/ready"
 """Peers → plant: a node's links are matched (std_msgs/String node name, latched)."""
-TOPIC_CLOCK = "/clock"
 
 SENSOR_TOPICS = (TOPIC_WHEEL, TOPIC_FLYWHEEL, TOPIC_PRESSURE, TOPIC_WRENCH)
 RECORDED_TOPICS = (TOPIC_CURRENT, *SENSOR_TOPICS)
@@ -50,10 +57,8 @@ NOT_STARTED_EXIT = 4
 """Exit code of a plant whose run could not start (a participant missing)."""
 NAMESPACE_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*")
 """A ROS namespace without its leading '/' (what ``-r __ns:=/...`` and launch accept)."""
-CLOCKS = ("lockstep", "realtime")
 EXTERNAL = "external"
 """The controller of a graph whose brake commands come from the user's own node."""
-STORAGES = ("mcap", "sqlite3")
 
 ParamValue = bool | int | float | str | list[str]
 
@@ -111,19 +116,19 @@ class GraphOptions:
     # is "external" (see controlled_run)
 
     run: RunSpec = field(default_factory=RunSpec)
-    clock: str = "lockstep"
+    clock: str = str(default("clock"))
     bag: Path | None = None
-    storage: str = "mcap"
-    sensor_noise: bool = False
-    timeout_s: float = 10.0  # long: a starved (not dead) node must not be declared lost
-    start_timeout_s: float = 60.0
-    safe_pressure_pa: float = 0.0
-    progress_s: float = 5.0
+    storage: str = str(default("storage"))
+    sensor_noise: bool = bool(default("noise"))
+    timeout_s: float = float(default("timeout_s"))  # long: a starved node is not a lost one
+    start_timeout_s: float = float(default("start_timeout_s"))
+    safe_pressure_pa: float = float(default("safe_pressure_bar"))
+    progress_s: float = float(default("progress_s"))
     controller: str | None = None
     replay: bool = False
-    parameter_services: bool = True
-    namespace: str = NAMESPACE
-    clock_topic: str = TOPIC_CLOCK
+    parameter_services: bool = bool(default("parameter_services"))
+    namespace: str = str(default("namespace"))
+    clock_topic: str = str(default("clock_topic"))
 
     def __post_init__(self) -> None:
         if not NAMESPACE_PATTERN.fullmatch(self.namespace):
@@ -147,16 +152,10 @@ LAUNCH_ARGUMENTS: dict[str, tuple[str, str]] = {
     "profile": ("osc-low", "current profile (simulate's --profile), or file"),
     "file": ("", "profile file: run (CSV or bag) whose current drives the graph"),
     "pressure_bar": ("30", "constant profile: brake pressure [bar]"),
-    "clock": ("lockstep", "lockstep | realtime"),
+    "rate_hz": ("0", "the run's rate [Hz] (0: the rig's simulation.output_rate_hz)"),
     "params_file": ("", "ROS 2 params file of the rig (default: bundled reference rig)"),
     "bag": ("", "rosbag2 folder to record into (empty: no recorder)"),
-    "storage": ("mcap", "mcap | sqlite3"),
-    "controller": ("", "anti-skid controller instead of the profile: threshold | slip | "
-                   "external (your own node publishes the commands)"),
-    "namespace": (NAMESPACE, "namespace of the rig's nodes and topics (a second rig: rig2)"),
-    "progress_s": ("5", "the plant says how far the run is every this many seconds; 0: never"),
-    "clock_topic": (TOPIC_CLOCK, "topic the plant publishes sim time on (a second lockstep "
-                    "rig: /rig2/clock, so each rig's sim-time listeners hear one clock)"),
+    **{o.name: (o.launch_default, o.help) for o in GRAPH_OPTIONS},
 }
 """Launch-file arguments: name -> (default, description)."""
 
@@ -191,14 +190,12 @@ def options_from_arguments(values: dict[str, str]) -> tuple[GraphOptions, Path]:
         except ValueError:
             raise GraphError(f"{name} must be a number, got {value(name)!r}") from None
 
-    pressure_pa = number("pressure_bar") * PA_PER_BAR
     controller = value("controller") or None
     run = controlled_run(RunSpec(profile=value("profile"), file=value("file"),
-                                 pressure_pa=pressure_pa), controller)
-    options = GraphOptions(run=run, clock=value("clock"), storage=value("storage"),
-                           bag=Path(value("bag")) if value("bag") else None,
-                           controller=controller, namespace=value("namespace").strip("/"),
-                           progress_s=number("progress_s"), clock_topic=value("clock_topic"))
+                                 pressure_pa=number("pressure_bar") * PA_PER_BAR,
+                                 rate_hz=number("rate_hz")), controller)
+    options = GraphOptions(run=run, bag=Path(value("bag")) if value("bag") else None,
+                           **graph_settings({o.name: value(o.name) for o in GRAPH_OPTIONS}))
     return options, Path(value("params_file") or default_config_files()[0])
 
 

@@ -256,7 +256,10 @@ def test_launch_file_starts_exactly_the_described_nodes(monkeypatch, tmp_path):
     options, _ = options_from_arguments(context)
     described = describe(options)
     assert [m["executable"] for m in made] == [n.name for n in described]
-    assert [m["parameters"][1] for m in made] == [n.parameters for n in described]
+    sessions = {m["parameters"][1].pop("run_id") for m in made}
+    assert len(sessions) == 1  # one session, every node in it
+    assert [m["parameters"][1] for m in made] == [
+        {k: v for k, v in n.parameters.items() if k != "run_id"} for n in described]
     assert all("additional_env" not in m for m in made)  # the user's environment, untouched
 
 

@@ -450,6 +450,26 @@ def test_two_rigs_share_a_domain_each_in_its_namespace(tmp_path, start):
                                    rtol=1e-9, atol=1e-6)
 
 
+def test_a_second_run_on_a_rig_in_use_refuses_to_start_and_leaves_the_first_alone(
+        tmp_path, start):
+    """A second `rig` on the namespace and domain of a running one (or of nodes left over
+    from one) once took the other run's nodes as its own: their ready messages started it
+    and their messages mixed in. Each session has an identity; the plant starts only with
+    nodes of its own, and ends nothing of the other run."""
+    first = start(rig_command("--profile", "constant", "--pressure-bar", "5", "--clock",
+                              "realtime", "--bag", str(tmp_path / "first"),
+                              overrides={**SHORT, "rig_test.max_duration_s": 60.0}))
+    wait_for(lambda: (tmp_path / "first" / "metadata.yaml").exists(), 120)
+    second = run_command(rig_command("--profile", "osc-low", "--no-bag"), timeout=180)
+    assert second.returncode != 0, second.stderr[-2000:]
+    assert "of another run" in second.stderr and "plant exit code 4" in second.stderr, \
+        second.stderr[-2000:]
+    # its actuator heard the first run's commands, stamped in wall time: it once stepped
+    # towards them (~1.7e12 steps) until the stop, then died with a traceback
+    assert "Traceback" not in second.stderr, second.stderr[-3000:]
+    assert first.poll() is None  # still running: no run end reached it
+
+
 def test_a_command_topic_remapped_on_its_source_and_the_actuator_is_found(tmp_path):
     """`-r brake/current_ref:=brake/cmd` on the profile and the actuator, as ROS users remap:
     the plant finds the command source through the graph (it once looked the literal name up

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import re
+import uuid
 from collections import Counter
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -111,6 +112,8 @@ class GraphOptions:
         clock_topic: where the plant publishes sim time (``/clock``): two lockstep rigs on
             one domain each take their own (``/rig2/clock``), so that a sim-time listener
             of one hears one clock.
+        run_id: this session's identity, given to every node: the plant starts only with
+            nodes of its own session (fresh for every GraphOptions).
     """
     # a controller graph is a rig test braking from rig_test.brake_start_s: run.profile
     # is "external" (see controlled_run)
@@ -129,6 +132,7 @@ class GraphOptions:
     parameter_services: bool = bool(default("parameter_services"))
     namespace: str = str(default("namespace"))
     clock_topic: str = str(default("clock_topic"))
+    run_id: str = field(default_factory=lambda: uuid.uuid4().hex[:12], compare=False)
 
     def __post_init__(self) -> None:
         if not NAMESPACE_PATTERN.fullmatch(self.namespace):
@@ -210,7 +214,8 @@ def run_parameters(run: RunSpec) -> dict[str, ParamValue]:
 def describe(options: GraphOptions) -> list[NodeSpec]:
     """The nodes of the graph for ``options``, plant first, with their expected links."""
     run = run_parameters(options.run)
-    shared: dict[str, ParamValue] = {"clock": options.clock}  # every node's
+    shared: dict[str, ParamValue] = {"clock": options.clock,  # every node's
+                                     "run_id": options.run_id}
     if not options.parameter_services:
         shared["parameter_services"] = False
     nodes = [

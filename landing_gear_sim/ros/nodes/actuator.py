@@ -43,6 +43,7 @@ class ActuatorNode(GraphNode):
         ActuatorBlock(params, scenario.step_s).step(0.0)  # JIT now: see PlantNode
         self._block = ActuatorBlock(params, scenario.step_s)
         self._done = 0 if self._lockstep else -1  # pressures are published up to this step
+        self._steps = int(scenario.current_a.size)  # the run's longest length
         self._current_a = 0.0  # the latest command
         self._refused = 0
         self._message = FluidPressure()
@@ -58,6 +59,15 @@ class ActuatorNode(GraphNode):
             return
         self._run_clock.observe(message.header.stamp)
         end = self._run_clock.step_of(message.header.stamp)
+        if self._lockstep and end > 2 * self._steps:
+            # another run's command (stamped in wall time: ~1.7e12 steps to go) once kept the
+            # valve stepping towards it until a stop killed it mid-publish; a controller's
+            # last command may end past the run (its period's end), not far past
+            end_s = self._steps * self._run_clock.step_s
+            self._refuse(f"a command stamped {ns_of(message.header.stamp) * 1e-9:.6f} s "
+                         f"ignored: far past the run's end ({end_s:g} s); a node of another "
+                         "run on this namespace?")
+            return
         if end <= self._done and self._lockstep:
             self._refuse(f"a command stamped {ns_of(message.header.stamp) * 1e-9:.6f} s ignored: "
                          f"it ends an interval the valve has passed (at "

@@ -165,12 +165,23 @@ def _parse_counts(items: Iterable[str]) -> dict[str, int]:
     return counts
 
 
+def ready_message(name: str, run_id: str) -> str:
+    """What a node says on TOPIC_READY: its name and its session (see :func:`read_ready`)."""
+    return f"{name} {run_id}".rstrip()
+
+
+def read_ready(text: str) -> tuple[str, str]:
+    """(node name, session) of a TOPIC_READY message (a node name holds no space)."""
+    name, _, run_id = text.partition(" ")
+    return name, run_id
+
+
 def announce_ready(node: GraphNode) -> Callable[[], None]:
     """A callback that tells the plant this node is linked (latched, once)."""
     publisher = node.publisher(String, TOPIC_READY, LATCHED_QOS)
 
     def ready() -> None:
-        publisher.publish(String(data=node.get_name()))
+        publisher.publish(String(data=ready_message(node.get_name(), node.run_id)))
         node.get_logger().info("linked; waiting for the plant")
 
     return ready
@@ -250,6 +261,8 @@ class GraphNode(Node):
         self.serves_parameters = bool(declare(
             self, "parameter_services", True, "serve ros2 param (false: the last bit of "
             "lockstep speed, no services)"))
+        self.run_id = str(declare(self, "run_id", "", "identity of the session this node "
+                                  "takes part in (the plant starts only with its own)"))
         self.run_samples: int | None = None
         self.exit_code = 0  # what the process exits with once the run is over
         self.subscription(UInt64, TOPIC_RUN_END, self._on_run_end, LATCHED_QOS)

@@ -104,7 +104,7 @@ RUN_PARAMETERS: dict[str, tuple[Any, str, float | None]] = {
 """The ``run.*`` parameters (see graph.run_parameters): name -> (default, description, the
 lowest value admitted)."""
 
-GRAPH_WIDE = frozenset(INDEX) | set(RUN_PARAMETERS) | {"clock", "parameter_services"}
+GRAPH_WIDE = frozenset(INDEX) | set(RUN_PARAMETERS) | {"clock", "parameter_services", "run_id"}
 """Parameters a params file may give every node (``/**``): not an error for a node that has
 no use for one (the recorder needs no friction curve)."""
 

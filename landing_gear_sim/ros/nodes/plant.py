@@ -46,6 +46,7 @@ from landing_gear_sim.ros.nodes.common import (
     RunFinishedError,
     main_for,
     outside_gaps,
+    read_ready,
 )
 from landing_gear_sim.ros.nodes.parameters import declare, rig_and_run
 from msg_tools.contract import (
@@ -120,8 +121,24 @@ class PlantNode(GraphNode):
 
     # --- start --------------------------------------------------------------------------
     def _on_ready(self, message: String) -> None:
-        self._ready.add(message.data)
-        self._maybe_start()
+        name, run_id = read_ready(message.data)
+        if run_id != self.run_id and not self._started:
+            self._refuse_foreign(name, run_id)
+        if run_id == self.run_id:
+            self._ready.add(name)
+            self._maybe_start()
+
+    def _refuse_foreign(self, name: str, run_id: str) -> None:
+        """A node of another session shares this rig's namespace and domain (a second run,
+        or a node left over from one): its messages would mix into this run. Not starting
+        is the one safe answer; no run end is published, as that would end the other run."""
+        self.get_logger().error(
+            f"{name} of another run (session {run_id or 'none'}; this run's: "
+            f"{self.run_id or 'none'}) is on this namespace and ROS_DOMAIN_ID: its messages "
+            "would mix into this run; stop it, or start this rig in another --namespace "
+            "or domain")
+        self.exit_code = NOT_STARTED_EXIT
+        raise RunFinishedError(self.get_name())
 
     def _on_linked(self) -> None:
         self._linked = True

@@ -132,7 +132,8 @@ class GraphOptions:
     parameter_services: bool = bool(default("parameter_services"))
     namespace: str = str(default("namespace"))
     clock_topic: str = str(default("clock_topic"))
-    run_id: str = field(default_factory=lambda: uuid.uuid4().hex[:12], compare=False)
+    # a letter first: launch and -p read an all-digit id (or 1e5...) as a number
+    run_id: str = field(default_factory=lambda: "s" + uuid.uuid4().hex[:12], compare=False)
 
     def __post_init__(self) -> None:
         if not NAMESPACE_PATTERN.fullmatch(self.namespace):

@@ -389,3 +389,26 @@ def test_a_wheel_channel_out_of_step_is_discovered_as_one(reference, tmp_path):
     assert finding.held_out is not None and finding.held_out < -10
     assert "measured wheel_speed_rad_s lags the simulation" in finding.evidence
     assert not result.signatures_after
+
+
+def test_the_consistency_chart_shows_each_relation_once_and_fits_a_screen(tmp_path):
+    """Eleven relations checked on eight runs drew one bar pair per check: ~1,000 px that
+    pushed the findings off the first screens. One row per relation (its worst run)."""
+    import matplotlib.image
+
+    from landing_gear_sim.diagnosis.relations import Check, Relation
+    from landing_gear_sim.report.diagnosis import plot_consistency, worst_per_relation
+
+    def check(relation, run, z):
+        return Check(relation, f"run_{run}", "braking", z * 0.01, 0.01, 0.5, "of x")
+
+    pairs = [(check(r, k, 0.5 + k), check(r, k, 0.2 + 3 * (7 - k) * (r is Relation.RUN_DRIFT)))
+             for r in Relation for k in range(8)]
+    rows = worst_per_relation(pairs)
+    assert [after.relation for (_, after), _ in rows] == list(Relation)
+    assert all(count == 8 for _, count in rows)
+    drift = next(pair for pair, _ in rows if pair[1].relation is Relation.RUN_DRIFT)
+    assert drift[1].run == "run_0"  # its worst under either model
+    path = plot_consistency(rows, tmp_path / "consistency.png")
+    height = matplotlib.image.imread(path).shape[0]
+    assert height <= 600, height

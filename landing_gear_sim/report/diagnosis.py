@@ -5,7 +5,6 @@ spectrum of the starting model; and the summary printed on the terminal."""
 from __future__ import annotations
 
 import html
-import textwrap
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -19,7 +18,7 @@ import numpy as np
 from landing_gear_sim.calibration.measured import CHANNELS
 from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
 from landing_gear_sim.diagnosis.findings import Finding
-from landing_gear_sim.diagnosis.relations import Z_VIOLATED, Check
+from landing_gear_sim.diagnosis.relations import Z_VIOLATED, Check, Relation
 from landing_gear_sim.diagnosis.residuals import Spectrum
 from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, HELD_OUT_THRESHOLD
 from landing_gear_sim.report.figures import DISPLAY_UNITS, save_figure
@@ -223,12 +222,12 @@ def _consistency_section(calibrated: Sequence[Check], extended: Sequence[Check],
     table = html_table(["relation", "run", "calibrated model", "extended model", "floor"],
                        [[after.relation, after.run, _check_cell(before), _check_cell(after),
                          f"{after.floor:.2g} {after.unit}"] for before, after in pairs])
-    shown = [pair for pair in pairs if max(_sigmas(pair[0]), _sigmas(pair[1])) > 1.0]
+    shown = worst_per_relation(pairs)
     caption = (f"<p>A relation is violated when its deviation is beyond {Z_VIOLATED:g} σ "
                "<i>and</i> beyond its physical floor (the size below which it does not matter "
                "to the rig, last column): an orange bar is beyond the σ line but within its "
-               f"floor. The chart shows the {len(shown)} checks beyond 1 σ under either model; "
-               f"the table all {len(pairs)}.</p>")
+               f"floor. The chart shows each of the {len(shown)} relations checked once, on its "
+               f"worst run; the table all {len(pairs)} checks.</p>")
     figure = plot_consistency(shown, folder / "consistency.png") if shown else None
     image = html_image(figure, folder) if figure else ""
     return ("Consistency of what the rig measures twice", caption + image + table)
@@ -249,15 +248,29 @@ def _check_cell(check: Check | None) -> str:
             + (" VIOLATED" if check.violated else ""))
 
 
-def plot_consistency(pairs: Sequence[tuple[Check | None, Check]], path: Path) -> Path:
-    """Each check's deviation in σ (log scale) under the calibrated model (pale) and the
-    extended one, against the violation threshold; red: violated, orange: over the
-    threshold but under its physical floor."""
-    fig, ax = plt.subplots(figsize=(9, 0.5 * len(pairs) + 1.4))
-    rows = np.arange(len(pairs))
+Pair = tuple[Check | None, Check]
+
+
+def worst_per_relation(pairs: Sequence[Pair]) -> list[tuple[Pair, int]]:
+    """Per relation (in the order first checked), its check furthest out under either model,
+    with how many checks the relation had."""
+    by_relation: dict[Relation, list[Pair]] = {}
+    for pair in pairs:
+        by_relation.setdefault(pair[1].relation, []).append(pair)
+    return [(max(group, key=lambda p: max(_sigmas(p[0]), _sigmas(p[1]))), len(group))
+            for group in by_relation.values()]
+
+
+def plot_consistency(rows: Sequence[tuple[Pair, int]], path: Path) -> Path:
+    """Each relation's worst check (``rows``: see :func:`worst_per_relation`), its deviation
+    in σ (log scale) under the calibrated model (pale) and the extended one, against the
+    violation threshold; red: violated, orange: over the threshold but under its floor."""
+    pairs = [pair for pair, _ in rows]
+    fig, ax = plt.subplots(figsize=(9, 0.3 * len(pairs) + 1.3))
+    rows_at = np.arange(len(pairs))
     for offset, alpha, index in ((-0.2, 0.4, 0), (0.2, 1.0, 1)):
         checks = [pair[index] for pair in pairs]
-        ax.barh(rows + offset, [_sigmas(c) for c in checks], height=0.4, alpha=alpha,
+        ax.barh(rows_at + offset, [_sigmas(c) for c in checks], height=0.4, alpha=alpha,
                 color=[_colour(c) for c in checks])
     ax.axvline(Z_VIOLATED, color="k", linestyle="--")
     keys: list[matplotlib.artist.Artist] = [
@@ -267,8 +280,9 @@ def plot_consistency(pairs: Sequence[tuple[Check | None, Check]], path: Path) ->
                                         label=f"{Z_VIOLATED:g} σ"))
     ax.set_xscale("log")
     ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-    ax.set_yticks(rows, [textwrap.fill(f"{after.relation} — {after.run}", 40)
-                         for _, after in pairs], fontsize=7)
+    ax.set_yticks(rows_at, [f"{after.relation} — {after.run}"
+                            + (f" (worst of {count})" if count > 1 else "")
+                            for (_, after), count in rows], fontsize=7)
     ax.invert_yaxis()
     ax.set_xlabel("|deviation| / σ (red: violated; orange: over σ but under its physical floor)")
     ax.legend(handles=keys, loc="lower right", fontsize=7)

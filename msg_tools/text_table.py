@@ -87,14 +87,10 @@ def read_table(text: str, wanted: Sequence[str], where: str,
     lines, notes = _complete_lines(text, where)
     dialect = sniff(lines, where)
     first, last = data_block(lines, dialect)
-    bare = {w: _name(w) for w in wanted}
+    bare = {w: header_name(w) for w in wanted}
     header_at, names = find_header(lines[:first], dialect, list(dict.fromkeys(bare.values())),
                                    where)
-    units = {**_header_units(lines[header_at], dialect, names)}
-    for row in lines[header_at + 1:first]:
-        cells = split(row, dialect.separator)
-        if len(cells) == len(names):
-            units.update({n: c.strip() for n, c in zip(names, cells, strict=True) if c.strip()})
+    units = header_units(lines[header_at:first], dialect, names)
     body = lines[first:last]
     numeric = [w for w in wanted if w not in text_columns]
     values, grouped = _numbers(body, dialect, names, [bare[w] for w in numeric], where, first)
@@ -106,6 +102,17 @@ def read_table(text: str, wanted: Sequence[str], where: str,
             columns[name] = _text(body, dialect, names.index(bare[name]))
     units.update({w: units[b] for w, b in bare.items() if w != b and b in units})
     return Table(columns, units, notes)
+
+
+def header_units(lines: list[str], dialect: Dialect, names: list[str]) -> dict[str, str]:
+    """Units by column name from the header (``lines[0]``: ``p [bar]``) and the units rows
+    below it (the other ``lines``, down to the data)."""
+    units = _header_units(lines[0], dialect, names)
+    for row in lines[1:]:
+        cells = split(row, dialect.separator)
+        if len(cells) == len(names):
+            units.update({n: c.strip() for n, c in zip(names, cells, strict=True) if c.strip()})
+    return units
 
 
 def _complete_lines(text: str, where: str) -> tuple[list[str], tuple[str, ...]]:
@@ -124,7 +131,7 @@ def _complete_lines(text: str, where: str) -> tuple[list[str], tuple[str, ...]]:
         _is_number(c, dialect.decimal) for c in cells[:-1])
     if not partial:
         return lines, ()
-    rows = sum(_is_data(line, dialect) for line in lines[:-1])
+    rows = sum(is_data(line, dialect) for line in lines[:-1])
     return lines[:-1], (f"{where}: last line cut short (the logger stopped mid-write?): "
                         f"{rows} complete rows read, the partial one dropped",)
 
@@ -196,7 +203,7 @@ def _is_float(text: str) -> bool:
     return True
 
 
-def _is_data(line: str, dialect: Dialect) -> bool:
+def is_data(line: str, dialect: Dialect) -> bool:
     cells = split(line, dialect.separator) if line.strip() else []
     return len(cells) == dialect.cells and sum(
         _is_number(c, dialect.decimal) for c in cells) >= 2
@@ -205,11 +212,11 @@ def _is_data(line: str, dialect: Dialect) -> bool:
 def data_block(lines: list[str], dialect: Dialect) -> tuple[int, int]:
     """[first, last) lines of the data: after the header and units rows, before a footer."""
     last = len(lines)
-    while last > 0 and not _is_data(lines[last - 1], dialect):
+    while last > 0 and not is_data(lines[last - 1], dialect):
         last -= 1
     first = 0
-    while first < last and not (_is_data(lines[first], dialect)
-                                and _is_data(lines[min(first + 1, last - 1)], dialect)):
+    while first < last and not (is_data(lines[first], dialect)
+                                and is_data(lines[min(first + 1, last - 1)], dialect)):
         first += 1
     return first, last
 
@@ -222,7 +229,7 @@ def find_header(above: list[str], dialect: Dialect, wanted: Sequence[str], where
         cells = split(above[index], dialect.separator)
         if len(cells) != dialect.cells:
             continue
-        names = [_name(cell) for cell in cells]
+        names = [header_name(cell) for cell in cells]
         candidates.append((index, names))
         if all(w in names for w in wanted):
             return index, names
@@ -238,7 +245,7 @@ def find_header(above: list[str], dialect: Dialect, wanted: Sequence[str], where
                          f"(found {', '.join(found)}); name them in a column-mapping file")
 
 
-def _name(cell: str) -> str:
+def header_name(cell: str) -> str:
     match = _UNIT_IN_HEADER.match(cell.strip())
     return (match.group(1) if match else cell).strip().strip('"')
 
@@ -256,7 +263,7 @@ def _header_units(line: str, dialect: Dialect, names: list[str]) -> dict[str, st
     return units
 
 
-def _delimiter(dialect: Dialect) -> str | None:
+def delimiter(dialect: Dialect) -> str | None:
     return None if dialect.separator == " " else dialect.separator
 
 
@@ -280,7 +287,7 @@ def _numbers(body: list[str], dialect: Dialect, names: list[str], wanted: list[s
 
 
 def _loaded(rows: list[str], dialect: Dialect, columns: list[int]) -> list[np.ndarray]:
-    return list(np.loadtxt(rows, delimiter=_delimiter(dialect), quotechar='"', ndmin=2,
+    return list(np.loadtxt(rows, delimiter=delimiter(dialect), quotechar='"', ndmin=2,
                            usecols=columns).T)
 
 
@@ -323,5 +330,5 @@ def _unreadable(exc: ValueError, names: list[str], where: str, offset: int
 
 
 def _text(body: list[str], dialect: Dialect, index: int) -> np.ndarray:
-    return np.loadtxt(body, delimiter=_delimiter(dialect), usecols=[index], quotechar='"',
+    return np.loadtxt(body, delimiter=delimiter(dialect), usecols=[index], quotechar='"',
                       dtype=str, ndmin=1)

@@ -18,6 +18,7 @@ from msg_tools.bag_io import write_bag
 from msg_tools.csv_io import format_csv, read_csv, read_mapping, write_csv
 from msg_tools.errors import RunFormatError
 from msg_tools.io import read_campaign, read_run, resample
+from msg_tools.run import Run
 
 MAPPING = """
 time_s: {column: t_ms, unit: ms}
@@ -278,3 +279,56 @@ def test_compare_prints_errors_in_the_units_of_its_plot(tmp_path, csv_file, caps
     pressure = next(line for line in capsys.readouterr().out.splitlines()
                     if line.lstrip().startswith("pressure_pa"))
     assert "0.5 bar" in pressure and "kN" not in pressure
+
+
+LAYOUTS = {
+    "the contract": lambda text: text,
+    "a preamble, a units row and semicolons": lambda text: "Logger: DL-7\nRig: A2\n"
+    + text.replace(",", ";").replace("\n", "\ns;A;bar;rad/s;rad/s;N;N\n", 1),
+    "Windows line ends and a BOM": lambda text: "\ufeff" + text.replace("\n", "\r\n"),
+    "a last line cut short": lambda text: text[:-20],
+    "a decimal comma": lambda text: text.replace(",", ";").replace(".", ","),
+    "a footer": lambda text: text + "end of log\n",
+    "an unreadable value deep down": lambda text: text[:len(text) * 2 // 3] + "x" + text[
+        len(text) * 2 // 3 + 1:],
+}
+
+
+STREAMED = [LAYOUTS[k] for k in ("the contract", "a preamble, a units row and semicolons",
+                                  "Windows line ends and a BOM")]
+
+
+@pytest.mark.parametrize("layout", LAYOUTS.values(), ids=LAYOUTS.keys())
+def test_a_long_text_run_read_from_the_open_file_is_the_run_read_whole(tmp_path, run,
+                                                                        monkeypatch, layout):
+    """A long CSV is read without its text in memory (an hour at 1 kHz took ~1 GB to read,
+    2.2 GB to convert): the same run, the same notes and the same error as the whole text
+    gives, whatever the layout."""
+    import msg_tools.text_stream
+
+    path = tmp_path / "long.csv"
+    path.write_text(layout(format_csv(run)), encoding="utf-8", newline="")
+    outcomes: list[Run | str] = []
+    whole_texts = []
+    read_text = msg_tools.text_stream.read_text
+    monkeypatch.setattr(msg_tools.text_stream, "read_text",
+                        lambda p: whole_texts.append(p) or read_text(p))
+    for threshold in (10**12, 1):
+        monkeypatch.setattr(msg_tools.text_stream, "LARGE_BYTES", threshold)
+        try:
+            outcomes.append(read_csv(path))
+        except RunFormatError as exc:
+            outcomes.append(str(exc))
+    whole, streamed = outcomes
+    # the layouts the first and last lines show are read from the file, not as text
+    assert len(whole_texts) == (1 if layout in STREAMED else 2)
+    if isinstance(whole, str):
+        assert streamed == whole
+        return
+    assert isinstance(streamed, Run)
+    for field in dataclasses.fields(whole):
+        a, b = getattr(whole, field.name), getattr(streamed, field.name)
+        if isinstance(a, np.ndarray):
+            np.testing.assert_array_equal(a, b, err_msg=field.name)
+        else:
+            assert a == b, field.name

@@ -1,6 +1,6 @@
 """Stopping benchmark: how fast and how cleanly the graph ends on each signal path.
 
-Run: ``python bench/stopping.py [--trials 20] [--workspace WS]``. Each path is a signal
+Run: ``python bench/stopping.py [--trials 20] [--workspace WS] [--busy 2]``. Each path is a signal
 (SIGINT, SIGTERM) sent to a lone node (``plant``, ``recorder``), to ``landing-gear-sim rig``
 (its PID; its whole process group, as a terminal's Ctrl-C) and, with ``--workspace`` (a
 colcon-built workspace and ``ros2`` on PATH, see ../shared/tools/rosenv-recipe.sh), to
@@ -24,6 +24,7 @@ import sys
 import tempfile
 import threading
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -138,9 +139,28 @@ def main() -> None:
     parser.add_argument("--trials", type=int, default=20, help="per path and signal")
     parser.add_argument("--workspace", type=Path, help="colcon workspace for ros2 launch")
     parser.add_argument("--only", default="", help="the paths whose name holds this text")
+    parser.add_argument("--busy", type=int, default=0,
+                        help="busy loops running beside the trials (a loaded machine)")
     args = parser.parse_args()
-    print(f"stop time per signal path, {args.trials} trials each (ratio: median against the "
-          f"bare rclpy node; target: {TARGET_S:g} s / max)")
+    print(f"stop time per signal path, {args.trials} trials each, {args.busy} busy loops "
+          f"beside (ratio: median against the bare rclpy node; target: {TARGET_S:g} s / max)")
+    with busy_loops(args.busy):
+        _paths(args)
+
+
+@contextlib.contextmanager
+def busy_loops(count: int) -> Iterator[None]:
+    """``count`` processes spinning on a core each while the trials run."""
+    loops = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(count)]
+    try:
+        yield
+    finally:
+        for loop in loops:
+            loop.kill()
+            loop.wait()
+
+
+def _paths(args: argparse.Namespace) -> None:
     print(f"{'path':38s} {'median':>8s} {'max':>8s} {'ratio':>5s} {'target':>6s}  clean")
     with tempfile.TemporaryDirectory() as folder:
         count = 0

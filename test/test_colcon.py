@@ -147,7 +147,10 @@ def short_params(tmp_path) -> Path:
     "profile:=constant pressure_bar:=20 storage:=sqlite3 namespace:=rig2 bag:={bag}",
     "controller:=slip clock:=realtime bag:={bag}",
     "profile:=file file:={csv}",
-], ids=["constant-sqlite3-namespace", "controller-realtime", "file"])
+    # the options the launch file had lacked beside rig's (issue 31): one table offers both
+    "noise:=true timeout_s:=2.5 start_timeout_s:=30 safe_pressure_bar:=1 progress_s:=0 "
+    "parameter_services:=false rate_hz:=1000 bag:={bag}",
+], ids=["constant-sqlite3-namespace", "controller-realtime", "file", "rig-options"])
 def test_ros2_launch_takes_every_argument(workspace, tmp_path, short_params, arguments):
     from landing_gear_sim.model.integrate import simulate
     from landing_gear_sim.model.parameters import load_parameters

@@ -107,8 +107,11 @@ def _row(name: str, trials: list[Trial], reference_s: float | None) -> None:
     median = statistics.median(times)
     codes = ",".join(sorted({str(t.code) for t in trials}))
     ratio = f"{median / reference_s:5.1f}x" if reference_s else "    -"
+    why = ", ".join(f"{sum(getattr(t, k) for t in trials)} {k}" for k in
+                    ("traceback", "escalated", "orphan") if any(getattr(t, k) for t in trials))
     print(f"{name:38s} {median:6.2f} s {max(times):6.2f} s {ratio} {TARGET_S / max(times):5.2f}x"
-          f"  {sum(t.clean for t in trials):2d}/{len(trials):<2d}  codes {codes}", flush=True)
+          f"  {sum(t.clean for t in trials):2d}/{len(trials):<2d}  codes {codes}"
+          + (f"  ({why})" if why else ""), flush=True)
 
 
 def paths(folder: Path, workspace: Path | None) -> dict[str, tuple[list[str], str, bool]]:

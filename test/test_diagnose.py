@@ -412,3 +412,15 @@ def test_the_consistency_chart_shows_each_relation_once_and_fits_a_screen(tmp_pa
     path = plot_consistency(rows, tmp_path / "consistency.png")
     height = matplotlib.image.imread(path).shape[0]
     assert height <= 600, height
+
+
+def test_a_verdict_of_none_shows_no_empty_findings_table(reference, tmp_path):
+    """The page of a `none` showed the findings table's header row with nothing under it."""
+    from landing_gear_sim.report.diagnosis import write_diagnosis_report
+
+    result = Diagnosis(verdict="none", findings=[], candidates=[], baseline={},
+                       start=reference, calibrated=reference, extended=reference,
+                       signatures_before=[], signatures_after=[])
+    page = write_diagnosis_report(result, tmp_path).read_text()
+    verdict = page[page.index("<h2>Verdict"):page.index("<h2>", page.index("<h2>Verdict") + 1)]
+    assert "nothing is missing" in verdict and "<table" not in verdict

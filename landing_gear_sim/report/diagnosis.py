@@ -5,6 +5,7 @@ spectrum of the starting model; and the summary printed on the terminal."""
 from __future__ import annotations
 
 import html
+import textwrap
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -187,7 +188,8 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
                f"fitting runs (accepted below {BIC_THRESHOLD:g}, and only if the held-out "
                f"runs improve by more than {-HELD_OUT_THRESHOLD:g} in the same "
                f"log-likelihood units).</p>")
-    sections = [("Verdict", verdict + findings), ("Candidates", candidates),
+    sections = [("Verdict", verdict + (findings if result.findings else "")),
+                ("Candidates", candidates),
                 ("Starting model, calibrated: fit %", html_table(
                     ["channel", "fit %"], [[c, f"{v:.2f}"] for c, v in result.baseline.items()])),
                 ("Residual structure", _structure_table(result))]
@@ -266,7 +268,7 @@ def plot_consistency(rows: Sequence[tuple[Pair, int]], path: Path) -> Path:
     in σ (log scale) under the calibrated model (pale) and the extended one, against the
     violation threshold; red: violated, orange: over the threshold but under its floor."""
     pairs = [pair for pair, _ in rows]
-    fig, ax = plt.subplots(figsize=(9, 0.3 * len(pairs) + 1.3))
+    fig, ax = plt.subplots(figsize=(9, 0.36 * len(pairs) + 1.3))
     rows_at = np.arange(len(pairs))
     for offset, alpha, index in ((-0.2, 0.4, 0), (0.2, 1.0, 1)):
         checks = [pair[index] for pair in pairs]
@@ -280,8 +282,9 @@ def plot_consistency(rows: Sequence[tuple[Pair, int]], path: Path) -> Path:
                                         label=f"{Z_VIOLATED:g} σ"))
     ax.set_xscale("log")
     ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-    ax.set_yticks(rows_at, [f"{after.relation} — {after.run}"
-                            + (f" (worst of {count})" if count > 1 else "")
+    # wrapped: a long relation's first letters were cut off at the figure's edge
+    ax.set_yticks(rows_at, [textwrap.fill(f"{after.relation} — {after.run}"
+                                          + (f" (worst of {count})" if count > 1 else ""), 44)
                             for (_, after), count in rows], fontsize=7)
     ax.invert_yaxis()
     ax.set_xlabel("|deviation| / σ (red: violated; orange: over σ but under its physical floor)")

@@ -99,7 +99,12 @@ def trial(command: list[str], ready: str, sig: int, group: bool) -> Trial:
         with contextlib.suppress(ProcessLookupError):
             os.killpg(process.pid, signal.SIGKILL)
     output = "".join(lines)
-    return Trial(seconds, code, "Traceback" in output, bool(ESCALATED.search(output)), orphan)
+    result = Trial(seconds, code, "Traceback" in output, bool(ESCALATED.search(output)), orphan)
+    if not result.clean:  # what made it so, for whoever reads the table
+        kept = Path(tempfile.gettempdir()) / f"stopping-unclean-{process.pid}.log"
+        kept.write_text(output)
+        print(f"  not clean: {kept}", file=sys.stderr, flush=True)
+    return result
 
 
 def _row(name: str, trials: list[Trial], reference_s: float | None) -> None:

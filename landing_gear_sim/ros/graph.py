@@ -119,19 +119,19 @@ class GraphOptions:
     # is "external" (see controlled_run)
 
     run: RunSpec = field(default_factory=RunSpec)
-    clock: str = str(default("clock"))
+    clock: str = default("clock")
     bag: Path | None = None
-    storage: str = str(default("storage"))
-    sensor_noise: bool = bool(default("noise"))
-    timeout_s: float = float(default("timeout_s"))  # long: a starved node is not a lost one
-    start_timeout_s: float = float(default("start_timeout_s"))
-    safe_pressure_pa: float = float(default("safe_pressure_bar"))
-    progress_s: float = float(default("progress_s"))
+    storage: str = default("storage")
+    sensor_noise: bool = default("noise")
+    timeout_s: float = default("timeout_s")  # long: a starved node is not a lost one
+    start_timeout_s: float = default("start_timeout_s")
+    safe_pressure_pa: float = default("safe_pressure_bar")
+    progress_s: float = default("progress_s")
     controller: str | None = None
     replay: bool = False
-    parameter_services: bool = bool(default("parameter_services"))
-    namespace: str = str(default("namespace"))
-    clock_topic: str = str(default("clock_topic"))
+    parameter_services: bool = default("parameter_services")
+    namespace: str = default("namespace")
+    clock_topic: str = default("clock_topic")
     # a letter first: launch and -p read an all-digit id (or 1e5...) as a number
     run_id: str = field(default_factory=lambda: "s" + uuid.uuid4().hex[:12], compare=False)
 

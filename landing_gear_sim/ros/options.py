@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 from landing_gear_sim.errors import GraphError
 from msg_tools.contract import NAMESPACE
@@ -107,20 +108,21 @@ GRAPH_OPTIONS = (
 OPTIONS = {o.name: o for o in GRAPH_OPTIONS}
 
 
-def default(name: str) -> Value:
-    """GraphOptions' default of option ``name`` (in its own unit: Pa for bar)."""
+def default(name: str) -> Any:
+    """GraphOptions' default of option ``name`` (in its own unit: Pa for bar); Any: of the
+    type its row gives, which GraphOptions' field declares."""
     value = OPTIONS[name].default
     return value * OPTIONS[name].scale if isinstance(value, float) else value
 
 
-def graph_settings(values: Mapping[str, Value]) -> dict[str, Value]:
+def graph_settings(values: Mapping[str, Value]) -> dict[str, Any]:
     """GraphOptions keyword arguments from the options' ``values`` by name (the launch
     file's texts or the CLI's typed values); an option not given keeps its default.
 
     Raises:
         GraphError: a value of the wrong type or not among its choices.
     """
-    settings: dict[str, Value] = {}
+    settings: dict[str, Any] = {}
     for name, raw in values.items():
         option = OPTIONS[name]
         value = option.parse(raw)

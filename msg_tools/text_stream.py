@@ -24,10 +24,8 @@ from .text_table import (
     Table,
     data_block,
     delimiter,
-    find_header,
-    header_name,
-    header_units,
     is_data,
+    read_header,
     read_table,
     read_text,
     sniff,
@@ -70,19 +68,14 @@ def _streamed(path: Path, wanted: Sequence[str], where: str) -> Table | None:
     first, last = data_block(head, dialect)
     if not 0 < first < last:
         return None
-    bare = {w: header_name(w) for w in wanted}
     try:
-        header_at, names = find_header(head[:first], dialect,
-                                       list(dict.fromkeys(bare.values())), where)
+        header = read_header(head[:first], dialect, wanted, where)
     except RunFormatError:
         return None
-    columns = [names.index(bare[w]) for w in wanted]
-    values = _load(path, encoding, dialect, columns, first)
+    values = _load(path, encoding, dialect, [header.column(w) for w in wanted], first)
     if values is None:
         return None
-    units = header_units(head[header_at:first], dialect, names)
-    units.update({w: units[b] for w, b in bare.items() if w != b and b in units})
-    return Table(dict(zip(wanted, values, strict=True)), units)
+    return Table(dict(zip(wanted, values, strict=True)), header.units)
 
 
 def _ends(path: Path) -> tuple[list[str], list[str], str] | None:

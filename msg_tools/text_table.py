@@ -87,32 +87,50 @@ def read_table(text: str, wanted: Sequence[str], where: str,
     lines, notes = _complete_lines(text, where)
     dialect = sniff(lines, where)
     first, last = data_block(lines, dialect)
-    bare = {w: header_name(w) for w in wanted}
-    header_at, names = find_header(lines[:first], dialect, list(dict.fromkeys(bare.values())),
-                                   where)
-    units = header_units(lines[header_at:first], dialect, names)
+    header = read_header(lines[:first], dialect, wanted, where)
     body = lines[first:last]
     numeric = [w for w in wanted if w not in text_columns]
-    values, grouped = _numbers(body, dialect, names, [bare[w] for w in numeric], where, first)
+    values, grouped = _numbers(body, dialect, header.names,
+                               [header.bare[w] for w in numeric], where, first)
     columns = dict(zip(numeric, values, strict=True))
     if grouped:
         notes += (f"{where}: numbers with thousands separators read ({grouped})",)
     for name in wanted:
         if name in text_columns:
-            columns[name] = _text(body, dialect, names.index(bare[name]))
-    units.update({w: units[b] for w, b in bare.items() if w != b and b in units})
-    return Table(columns, units, notes)
+            columns[name] = _text(body, dialect, header.column(name))
+    return Table(columns, header.units, notes)
 
 
-def header_units(lines: list[str], dialect: Dialect, names: list[str]) -> dict[str, str]:
-    """Units by column name from the header (``lines[0]``: ``p [bar]``) and the units rows
-    below it (the other ``lines``, down to the data)."""
-    units = _header_units(lines[0], dialect, names)
-    for row in lines[1:]:
+@dataclass(frozen=True)
+class Header:
+    """The header above a data block: its cell ``names``, the ``units`` it gives (by column
+    name, and by each wanted name), and each wanted name as a bare cell name (``t [s]`` →
+    ``t``)."""
+
+    names: list[str]
+    units: dict[str, str]
+    bare: dict[str, str]
+
+    def column(self, wanted: str) -> int:
+        return self.names.index(self.bare[wanted])
+
+
+def read_header(above: list[str], dialect: Dialect, wanted: Sequence[str], where: str
+                ) -> Header:
+    """The :class:`Header` of the lines ``above`` the data that names ``wanted``.
+
+    Raises:
+        RunFormatError: no header row, or a wanted column missing (named).
+    """
+    bare = {w: _name(w) for w in wanted}
+    header_at, names = find_header(above, dialect, list(dict.fromkeys(bare.values())), where)
+    units = _header_units(above[header_at], dialect, names)
+    for row in above[header_at + 1:]:  # units rows, down to the data
         cells = split(row, dialect.separator)
         if len(cells) == len(names):
             units.update({n: c.strip() for n, c in zip(names, cells, strict=True) if c.strip()})
-    return units
+    units.update({w: units[b] for w, b in bare.items() if w != b and b in units})
+    return Header(names, units, bare)
 
 
 def _complete_lines(text: str, where: str) -> tuple[list[str], tuple[str, ...]]:
@@ -229,7 +247,7 @@ def find_header(above: list[str], dialect: Dialect, wanted: Sequence[str], where
         cells = split(above[index], dialect.separator)
         if len(cells) != dialect.cells:
             continue
-        names = [header_name(cell) for cell in cells]
+        names = [_name(cell) for cell in cells]
         candidates.append((index, names))
         if all(w in names for w in wanted):
             return index, names
@@ -245,7 +263,7 @@ def find_header(above: list[str], dialect: Dialect, wanted: Sequence[str], where
                          f"(found {', '.join(found)}); name them in a column-mapping file")
 
 
-def header_name(cell: str) -> str:
+def _name(cell: str) -> str:
     match = _UNIT_IN_HEADER.match(cell.strip())
     return (match.group(1) if match else cell).strip().strip('"')
 

@@ -88,15 +88,23 @@ def _clipped_pressure(runs: Sequence[ClassifiedRun], params: RigParameters) -> s
             "bar: a transducer clipping there? Its samples read the pressure low")
 
 
-def _counted_wheel(runs: Sequence[ClassifiedRun]) -> str | None:
-    """The wheel channel of a counting encoder (its speeds on a lattice: whole lines per
-    sample), with the lines per revolution that lattice means."""
-    braking = [r for r in runs if r.braking]
-    steps = [lattice_step(r.wheel_speed_rad_s) for r in braking]
-    if not braking or None in steps:
+def counted_wheel_step(runs: Sequence[ClassifiedRun]) -> float | None:
+    """The speed per count of a counting encoder's wheel channel (every braking run's speeds
+    on a lattice: whole lines per sample), median over the runs; None: an analogue channel
+    or no braking run."""
+    steps = [lattice_step(r.wheel_speed_rad_s) for r in runs if r.braking]
+    if not steps or None in steps:
         return None
-    step = float(np.median([s for s in steps if s is not None]))
-    rate = float(np.median([r.rate_hz for r in braking]))
+    return float(np.median([s for s in steps if s is not None]))
+
+
+def _counted_wheel(runs: Sequence[ClassifiedRun]) -> str | None:
+    """The wheel channel of a counting encoder, with the lines per revolution its lattice
+    means."""
+    step = counted_wheel_step(runs)
+    if step is None:
+        return None
+    rate = float(np.median([r.rate_hz for r in runs if r.braking]))
     return (f"wheel_speed_rad_s is counted: {2 * math.pi * rate / step:.0f} lines per "
             f"revolution ({step:.3g} rad/s per count at {rate:g} Hz); effects in the wheel "
             "channel (a skew, a ripple with its angle) are judged through that resolution, "

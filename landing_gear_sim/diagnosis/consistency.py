@@ -34,7 +34,7 @@ import numpy as np
 import scipy.signal
 
 from landing_gear_sim.calibration import braking as br
-from landing_gear_sim.calibration.plausibility import lattice_step
+from landing_gear_sim.calibration.plausibility import counted_wheel_step
 from landing_gear_sim.calibration.runs import ClassifiedRun, RunKind
 from landing_gear_sim.calibration.statistics import (
     inverse_variance_weights,
@@ -128,8 +128,7 @@ def coarse_channels(runs: Sequence[ClassifiedRun], checks: Sequence[Check]) -> l
     """What a counted wheel channel cannot resolve (for ``problems``: a ``none`` through a
     coarse encoder is no proof of a smooth wheel): the smallest ripple with the wheel's angle
     a run's free-rolling check would call violated, Z_VIOLATED of its σ (median over runs)."""
-    braking = [r for r in runs if r.braking]
-    if not braking or any(lattice_step(r.wheel_speed_rad_s) is None for r in braking):
+    if counted_wheel_step(runs) is None:
         return []
     stds = [c.std for c in checks if c.relation == WHEEL_ANGLE]
     if not stds:

@@ -195,12 +195,12 @@ def options_from_arguments(values: dict[str, str]) -> tuple[GraphOptions, Path]:
         except ValueError:
             raise GraphError(f"{name} must be a number, got {value(name)!r}") from None
 
-    controller = value("controller") or None
+    settings = graph_settings({o.name: value(o.name) for o in GRAPH_OPTIONS})
     run = controlled_run(RunSpec(profile=value("profile"), file=value("file"),
                                  pressure_pa=number("pressure_bar") * PA_PER_BAR,
-                                 rate_hz=number("rate_hz")), controller)
+                                 rate_hz=number("rate_hz")), settings["controller"])
     options = GraphOptions(run=run, bag=Path(value("bag")) if value("bag") else None,
-                           **graph_settings({o.name: value(o.name) for o in GRAPH_OPTIONS}))
+                           **settings)
     return options, Path(value("params_file") or default_config_files()[0])
 
 

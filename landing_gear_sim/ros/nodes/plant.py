@@ -122,11 +122,11 @@ class PlantNode(GraphNode):
     # --- start --------------------------------------------------------------------------
     def _on_ready(self, message: String) -> None:
         name, run_id = read_ready(message.data)
-        if run_id != self.run_id and not self._started:
-            self._refuse_foreign(name, run_id)
         if run_id == self.run_id:
             self._ready.add(name)
             self._maybe_start()
+        elif not self._started:
+            self._refuse_foreign(name, run_id)
 
     def _refuse_foreign(self, name: str, run_id: str) -> None:
         """A node of another session shares this rig's namespace and domain (a second run,

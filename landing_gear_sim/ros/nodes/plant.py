@@ -97,6 +97,7 @@ class PlantNode(GraphNode):
         self._latest = {ACTUATOR: 0.0, LOADING: 0.0}
         self._lost: set[str] = set()
         self._ready: set[str] = set()
+        self._heard = 0  # ready messages, of any session
         self._linked = self._started = self._done = False
         self._messages = _Messages()
         self._out = {topic: self.publisher(kind, topic) for topic, kind in (
@@ -106,7 +107,8 @@ class PlantNode(GraphNode):
         inputs = [self.subscription(FluidPressure, TOPIC_HYDRAULIC, self._on_pressure,
                                     DATA_QOS),
                   self.subscription(Vector3Stamped, TOPIC_LOAD, self._on_load)]
-        self.subscription(String, TOPIC_READY, self._on_ready, LATCHED_QOS)
+        self._ready_topic = self.subscription(String, TOPIC_READY, self._on_ready,
+                                              LATCHED_QOS).topic_name
         self._handshake = Handshake(self, self._out, inputs, self._on_linked)
         self._created = self._last_progress = time.monotonic()
         self._wall_start = self._reported = 0.0
@@ -122,6 +124,7 @@ class PlantNode(GraphNode):
     # --- start --------------------------------------------------------------------------
     def _on_ready(self, message: String) -> None:
         name, run_id = read_ready(message.data)
+        self._heard += 1
         if run_id == self.run_id:
             self._ready.add(name)
             self._maybe_start()
@@ -145,7 +148,10 @@ class PlantNode(GraphNode):
         self._maybe_start()
 
     def _maybe_start(self) -> None:
+        # every node announcing on this namespace heard first: a node of another session
+        # whose ready message came after this session's had let a second run start
         if (self._started or not self._linked or not self._participants <= self._ready
+                or self.count_publishers(self._ready_topic) > self._heard
                 or outside_gaps(self, self._out)):
             return
         self._started = True

@@ -57,12 +57,14 @@ class SlipController(Node):
         self.next_ns = 0  # the stamp at which the last command runs out
         self.free_ratio = 0.0
         self.samples: dict[int, dict[str, float]] = {}
+        self.unsent: list[JointState] = []
         self.out = self.create_publisher(JointState, "brake/current_ref", DATA)
         for joint in ("wheel", "flywheel"):
             self.create_subscription(JointState, f"{joint}/joint_states",
                                      lambda m, j=joint: self.on_sample(j, m), DATA)
         self.create_subscription(UInt64, "run_end", self.on_end, LATCHED)
         self.ended = Future()
+        self.create_timer(0.01, self.flush)
 
     def on_sample(self, joint: str, message: JointState) -> None:
         stamp = nanoseconds(message)
@@ -92,7 +94,21 @@ class SlipController(Node):
         command = JointState(name=["brake_valve"], effort=[current_a])
         command.header.frame_id = "brake_valve"
         command.header.stamp.sec, command.header.stamp.nanosec = divmod(until_ns, 1_000_000_000)
-        self.out.publish(command)
+        self.unsent.append(command)
+        self.flush()
+
+    def flush(self) -> None:
+        """Send the commands held back until the actuator's link is matched at this end.
+
+        DDS matches the two ends of a link each on its own, and this node may hear the
+        plant's first sample before it has discovered the actuator: a command published
+        then is lost, and in lockstep the run waits for it in vain (1 run in 3 did)."""
+        readers = self.get_subscriptions_info_by_topic(self.out.topic_name)
+        if (not any(reader.node_name == "actuator" for reader in readers)
+                or self.out.get_subscription_count() < len(readers)):
+            return
+        while self.unsent:
+            self.out.publish(self.unsent.pop(0))
 
     def on_end(self, message: UInt64) -> None:
         self.get_logger().info(f"run ended after {message.data} samples")

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.blocks import ActuatorBlock, LoadingBlock, PlantBlock
 from landing_gear_sim.model.integrate import SimulationResult
 from landing_gear_sim.model.parameters import RigParameters
@@ -61,7 +62,7 @@ def make_controller(kind: str, rig: RigParameters, step_s: float,
     It brakes from ``rig_test.brake_start_s`` (the rig procedure) on.
     """
     settings, state = controller_arrays(kind, rig, step_s, values)
-    start_s = rig.number("rig_test.brake_start_s")
+    start_s = rig.number(K.RIG_TEST_BRAKE_START_S)
     if kind == "threshold":
         return lambda t, wheel, flywheel: threshold_step(settings, state, start_s - t, wheel)
     return lambda t, wheel, flywheel: slip_step(settings, state, start_s - t, wheel, flywheel)
@@ -73,10 +74,10 @@ def controller_arrays(kind: str, rig: RigParameters, step_s: float,
     """The validated settings and the initial state of controller ``kind`` as the
     compiled step functions take them (float arrays)."""
     settings = controller_settings(kind, values)
-    wheel_r = rig.number("wheel.unloaded_radius_m")
+    wheel_r = rig.number(K.WHEEL_UNLOADED_RADIUS_M)
     if isinstance(settings, ThresholdParams):
         return threshold_vector(settings), threshold_state(settings, wheel_r, step_s)
-    return slip_vector(settings), slip_state(wheel_r, rig.number("flywheel.radius_m"), step_s)
+    return slip_vector(settings), slip_state(wheel_r, rig.number(K.FLYWHEEL_RADIUS_M), step_s)
 
 
 def with_surface(rig: RigParameters, surface: str) -> RigParameters:
@@ -86,7 +87,7 @@ def with_surface(rig: RigParameters, surface: str) -> RigParameters:
     if surface not in SURFACES:
         raise ControllerError(f"unknown surface {surface!r}; choose dry, {', '.join(SURFACES)}")
     t1, t2, t3 = SURFACES[surface]
-    return rig.replace({"friction.theta1": t1, "friction.theta2": t2, "friction.theta3": t3},
+    return rig.replace({K.FRICTION_THETA1: t1, K.FRICTION_THETA2: t2, K.FRICTION_THETA3: t3},
                        f"surface {surface}")
 
 
@@ -127,7 +128,7 @@ def constant_pressure_baseline(rig: RigParameters, margin: float = 0.98,
         result = simulate(rig, constant_pressure_test(rig, pressure_pa))
         return braking_metrics(result.to_run(), rig).lock_events > 0
 
-    low, high = 0.0, rig.number("actuator.max_pressure_pa")
+    low, high = 0.0, rig.number(K.ACTUATOR_MAX_PRESSURE_PA)
     if not locks(high):
         low = high
     for _ in range(iterations if low < high else 0):

@@ -16,6 +16,7 @@ from collections.abc import Mapping
 import numpy as np
 from numba import njit
 
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.actuator import actuator_matrices, actuator_state, actuator_step
 from landing_gear_sim.model.integrate import STOP_REASONS, SimulationResult
 from landing_gear_sim.model.parameters import RigParameters
@@ -118,7 +119,7 @@ def compiled_closed_loop(rig: RigParameters, kind: str,
     rows, stop = closed_loop_kernel(
         vector, actuator_matrices(vector, scenario.step_s), scenario.step_s,
         scenario.initial_speed_m_s, scenario.stop_speed_m_s,
-        rig.number("rig_test.brake_start_s"), rig.number("flywheel.radius_m"), delay_s,
+        rig.number(K.RIG_TEST_BRAKE_START_S), rig.number(K.FLYWHEEL_RADIUS_M), delay_s,
         math.ceil(delay_s / scenario.step_s) + 2, np.array(sensors.runout),
         CONTROLLERS.index(kind), settings, state, out)
     return SimulationResult(scenario, rig, out[:rows].copy(), STOP_REASONS[stop])

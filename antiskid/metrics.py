@@ -14,6 +14,7 @@ import scipy.integrate
 import scipy.signal
 
 from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.elements import slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import (
@@ -133,7 +134,7 @@ def _efficiency(rig: RigParameters, friction: np.ndarray, speed_m_s: np.ndarray,
     sample's load (a tyre's load sensitivity) and, on a runway whose surface changes below
     ``friction.change_speed_m_s`` (a μ-jump), of the surface under the tyre."""
     available = peak * load_factor_at(rig, load_n)
-    change = rig.number("friction.change_speed_m_s")
+    change = rig.number(K.FRICTION_CHANGE_SPEED_M_S)
     if change > 0.0:
         after, _ = peak_friction(rig.replace({f"friction.theta{i}": rig.number(
             f"friction.after_theta{i}") for i in (1, 2, 3)}, "the surface after the change"))

@@ -10,6 +10,7 @@ import pytest
 import yaml
 
 from landing_gear_sim.errors import ParameterError
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import (
     INDEX,
     N_PARAMS,
@@ -175,3 +176,17 @@ def test_set_reads_an_exponent_without_a_dot_as_ros_does():
         "friction.load_sensitivity_per_n=1e-5"), parse_assignment("radius.b_m_per_n=5E-7")]))
     assert params.number("friction.load_sensitivity_per_n") == 1e-5
     assert params.number("radius.b_m_per_n") == 5e-7
+
+
+def test_every_schema_key_is_a_constant_of_the_keys_module_in_the_schemas_order():
+    constants = [(name, value) for name, value in vars(K).items() if name.isupper()]
+    assert [value for _, value in constants] == [spec.key for spec in SPECS]
+    assert all(name == value.replace(".", "_").upper() for name, value in constants)
+
+
+def test_the_schema_order_is_only_appended_to():
+    """A key moved or inserted before the last shifts the indices a cached compiled module
+    still reads: wrong physics without a word."""
+    frozen = [line for line in (Path(__file__).parent / "schema_order.txt").read_text()
+              .splitlines() if line and not line.startswith("#")]
+    assert [spec.key for spec in SPECS][:len(frozen)] == frozen

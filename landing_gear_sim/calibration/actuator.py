@@ -14,6 +14,7 @@ from scipy.optimize import least_squares
 
 from landing_gear_sim.calibration.statistics import Estimate, covariance_std
 from landing_gear_sim.model import elements as el
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.actuator import actuator_pressure, second_order_response
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.scenario import logged_to_held
@@ -21,8 +22,8 @@ from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.run import Run
 from msg_tools.units import PA_PER_BAR
 
-STATIC_MAP = ("actuator.deadband_current_a", "actuator.map_k1_pa_per_a",
-              "actuator.map_k2_pa_per_a2", "actuator.max_pressure_pa")
+STATIC_MAP = (K.ACTUATOR_DEADBAND_CURRENT_A, K.ACTUATOR_MAP_K1_PA_PER_A,
+              K.ACTUATOR_MAP_K2_PA_PER_A2, K.ACTUATOR_MAX_PRESSURE_PA)
 FRF_BAND_HZ = (0.5, 100.0)  # the sweep's band
 MIN_COHERENCE = 0.8  # FRF bins fitted: the measured pressure follows the valve there
 
@@ -43,7 +44,7 @@ def fit_static_map(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
     """Dead-band, k1, k2, saturation from quasi-static ramps (paper Fig. 8)."""
     current = np.concatenate([r.current_a for r in runs])
     pressure = SensorModel.of(p).true_pressure(np.concatenate([r.pressure_pa for r in runs]))
-    max_current = p.number("actuator.max_current_a")
+    max_current = p.number(K.ACTUATOR_MAX_CURRENT_A)
     scale = np.array([p.number(k) or 1.0 for k in STATIC_MAP])
     scale[0] = max(scale[0], 0.05)
 
@@ -71,8 +72,8 @@ def actuator_frf(run: Run, params: RigParameters) -> FrfEstimate:
     _, coherence = scipy.signal.coherence(u, y, fs, nperseg=nperseg)
     with np.errstate(divide="ignore", invalid="ignore"):
         h1 = pyu / puu  # scipy's csd(u, y) is already the cross-spectrum of H1
-    model = second_order_response(f, params.number("actuator.natural_frequency_hz"),
-                                  params.number("actuator.damping_ratio"), 1.0)
+    model = second_order_response(f, params.number(K.ACTUATOR_NATURAL_FREQUENCY_HZ),
+                                  params.number(K.ACTUATOR_DAMPING_RATIO), 1.0)
     return FrfEstimate(run.name, f, h1, coherence, model)
 
 
@@ -84,8 +85,8 @@ def fit_actuator_dynamics(runs: Sequence[Run], p: RigParameters
     f, h1 = frf.frequency_hz, frf.response
     band = ((f >= FRF_BAND_HZ[0]) & (f <= FRF_BAND_HZ[1]) & (frf.coherence > MIN_COHERENCE)
             & np.isfinite(h1))
-    f0 = p.number("actuator.natural_frequency_hz")
-    zeta0 = p.number("actuator.damping_ratio")
+    f0 = p.number(K.ACTUATOR_NATURAL_FREQUENCY_HZ)
+    zeta0 = p.number(K.ACTUATOR_DAMPING_RATIO)
     weight = np.sqrt(frf.coherence[band])
 
     def frf_residual(theta: np.ndarray) -> np.ndarray:
@@ -98,8 +99,8 @@ def fit_actuator_dynamics(runs: Sequence[Run], p: RigParameters
     held = logged_to_held(run.current_a)
 
     def time_residual(theta: np.ndarray) -> np.ndarray:
-        trial = p.replace({"actuator.natural_frequency_hz": theta[0] / (2 * math.pi),
-                           "actuator.damping_ratio": theta[1]})
+        trial = p.replace({K.ACTUATOR_NATURAL_FREQUENCY_HZ: theta[0] / (2 * math.pi),
+                           K.ACTUATOR_DAMPING_RATIO: theta[1]})
         read = sensors.pressure_channel(run.time_s, actuator_pressure(trial, held, run.rate_hz))
         return (read - run.pressure_pa) / PA_PER_BAR
 
@@ -109,10 +110,10 @@ def fit_actuator_dynamics(runs: Sequence[Run], p: RigParameters
     std = covariance_std(fit, 2)
     names = (run.name,)
     estimates = [
-        Estimate("actuator.natural_frequency_hz", fit.x[0] / (2 * math.pi),
+        Estimate(K.ACTUATOR_NATURAL_FREQUENCY_HZ, fit.x[0] / (2 * math.pi),
                  std[0] / (2 * math.pi), names,
                  f"output error on pressure (FRF fit gave {f_frf:.2f} Hz)"),
-        Estimate("actuator.damping_ratio", fit.x[1], std[1], names,
+        Estimate(K.ACTUATOR_DAMPING_RATIO, fit.x[1], std[1], names,
                  f"output error on pressure (FRF fit gave {zeta_frf:.3f})"),
     ]
     fitted = p.replace({e.key: e.value for e in estimates}, "identify")

@@ -21,6 +21,7 @@ from landing_gear_sim.calibration.statistics import (
     run_weights,
 )
 from landing_gear_sim.errors import IdentificationError
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.elements import brake_torques, fade_factor, slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s, rolling_radius_at
@@ -78,7 +79,7 @@ def prepare(run: ClassifiedRun, p: RigParameters) -> Braking:
 
 def slip(b: Braking, p: RigParameters) -> np.ndarray:
     """The slip of the filtered signals (the unloaded radius), (n,)."""
-    return slip_ratio(b.speed_m_s, b.wheel, p.number("wheel.unloaded_radius_m"))
+    return slip_ratio(b.speed_m_s, b.wheel, p.number(K.WHEEL_UNLOADED_RADIUS_M))
 
 
 def free_rolling(b: Braking) -> np.ndarray:
@@ -90,10 +91,10 @@ def hub_speed(b: Braking, p: RigParameters) -> np.ndarray:
     """v_h = v_f − L θ̇, θ from the measured F_x through the gear's spring-damper (eq. 6)."""
     if not p.has("gear_walk"):
         return b.speed_m_s
-    length = p.number("gear_walk.length_m")
-    system = ([length, 0.0], [p.number("gear_walk.inertia_kg_m2"),
-                              p.number("gear_walk.damping_n_m_s_per_rad"),
-                              p.number("gear_walk.stiffness_n_m_per_rad")])
+    length = p.number(K.GEAR_WALK_LENGTH_M)
+    system = ([length, 0.0], [p.number(K.GEAR_WALK_INERTIA_KG_M2),
+                              p.number(K.GEAR_WALK_DAMPING_N_M_S_PER_RAD),
+                              p.number(K.GEAR_WALK_STIFFNESS_N_M_PER_RAD)])
     # lsim's linear interpolation of the input, as a digital filter: lsim steps its state in
     # a Python loop, ~40x slower on a run of 10^5 samples
     numerator, denominator, _ = scipy.signal.cont2discrete(system, 1.0 / b.run.rate_hz,
@@ -109,12 +110,12 @@ def fit_unloaded_radius(runs: Sequence[Braking], p: RigParameters) -> Estimate:
         m = free_rolling(b)
         if m.sum() > 50:
             r_eff = np.mean(b.speed_m_s[m]) / np.mean(b.wheel[m])
-            values.append(r_eff + (p.number("wheel.unloaded_radius_m")
+            values.append(r_eff + (p.number(K.WHEEL_UNLOADED_RADIUS_M)
                                    - float(np.mean(rolling_radius_at(p, b.load[m])))))
     if not values:
         raise IdentificationError("no free-rolling phase before braking")
     std = float(np.std(values) / math.sqrt(len(values))) if len(values) > 1 else float("nan")
-    return Estimate("wheel.unloaded_radius_m", float(np.mean(values)), std,
+    return Estimate(K.WHEEL_UNLOADED_RADIUS_M, float(np.mean(values)), std,
                     tuple(b.run.name for b in runs), "free rolling v/ω, a and b kept")
 
 
@@ -143,14 +144,14 @@ def fit_flywheel(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
     std_inv, std_ratio = linear_std(x, y - x @ coef, x.shape[1])[:2]
     inv_mass, alpha_over_mass = coef[:2]
     mass = 1.0 / inv_mass
-    radius = p.number("flywheel.radius_m")
+    radius = p.number(K.FLYWHEEL_RADIUS_M)
     names = tuple(b.run.name for b in runs)
     alpha = alpha_over_mass * mass
     std_alpha = abs(alpha) * math.hypot(std_ratio / alpha_over_mass, std_inv * mass)
     return [
-        Estimate("flywheel.inertia_kg_m2", mass * radius ** 2,
+        Estimate(K.FLYWHEEL_INERTIA_KG_M2, mass * radius ** 2,
                  mass ** 2 * std_inv * radius ** 2, names, "integrated momentum balance"),
-        Estimate("drag.coeff_n_s2_per_m2", float(alpha), float(std_alpha), names,
+        Estimate(K.DRAG_COEFF_N_S2_PER_M2, float(alpha), float(std_alpha), names,
                  "integrated momentum balance"),
     ]
 
@@ -163,7 +164,7 @@ def _sample_weights(per_run: Sequence[np.ndarray]) -> np.ndarray:
 
 def torque_balance(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
     """Brake torque r F_x − J_w ω̇ [N m] and the energy the brake absorbed, ∫ T_b ω dt [J]."""
-    torque = rolling_radius_at(p, b.load) * b.force - p.number("wheel.inertia_kg_m2") * b.wheel_rate
+    torque = rolling_radius_at(p, b.load) * b.force - p.number(K.WHEEL_INERTIA_KG_M2) * b.wheel_rate
     dt = np.diff(b.time_s, prepend=b.time_s[0])
     power = np.where(b.time_s > b.start_s - 0.1, np.clip(torque, 0, None), 0.0) \
         * np.clip(b.wheel, 0, None)
@@ -180,10 +181,10 @@ def model_torque(b: Braking, p: RigParameters, energy: np.ndarray, mask: np.ndar
     torque = brake_torques(_without_runout(p).vector(), pressure,
                            np.ascontiguousarray(energy[mask]),
                            np.ascontiguousarray(b.wheel[mask]), np.zeros_like(pressure))
-    return torque * (1.0 + p.number("brake.gain_drift_per_run") * b.run.campaign_order)
+    return torque * (1.0 + p.number(K.BRAKE_GAIN_DRIFT_PER_RUN) * b.run.campaign_order)
 
 
-RUNOUT_AMPLITUDES = ("brake.runout_1", "brake.runout_2")
+RUNOUT_AMPLITUDES = (K.BRAKE_RUNOUT_1, K.BRAKE_RUNOUT_2)
 
 
 def _without_runout(p: RigParameters) -> RigParameters:
@@ -227,9 +228,9 @@ def fit_brake_gain(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
     if not p.has("brake_fade"):
         gain = float(pr @ t / (pr @ pr))
         gain_std = float(linear_std(pr[:, None], t - gain * pr, 1)[0])
-        return [Estimate("brake.gain_n_m_per_pa", gain, gain_std, names, "wheel torque balance")]
-    keys = ("brake.gain_n_m_per_pa", "brake.fade_fraction", "brake.fade_energy_j",
-            "brake.fade_shape")
+        return [Estimate(K.BRAKE_GAIN_N_M_PER_PA, gain, gain_std, names, "wheel torque balance")]
+    keys = (K.BRAKE_GAIN_N_M_PER_PA, K.BRAKE_FADE_FRACTION, K.BRAKE_FADE_ENERGY_J,
+            K.BRAKE_FADE_SHAPE)
 
     def residual(theta: np.ndarray) -> np.ndarray:
         gain, fraction, log_energy, shape = theta

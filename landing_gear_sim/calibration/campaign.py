@@ -16,6 +16,7 @@ import numpy as np
 from landing_gear_sim.calibration.logger import Logger
 from landing_gear_sim.calibration.measured import run_parameters
 from landing_gear_sim.calibration.wheel_angle import BRAKE_RUNOUT_KEYS, has_brake_runout
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import RigParameters
@@ -24,14 +25,14 @@ from landing_gear_sim.model.sensors import RUNOUT_KEYS, SensorModel
 from msg_tools.csv_io import write_csv
 from msg_tools.units import PA_PER_BAR
 
-DEVIATING = ("flywheel.inertia_kg_m2", "drag.coeff_n_s2_per_m2", "friction.theta1",
-             "friction.theta2", "friction.theta3", "brake.gain_n_m_per_pa",
-             "actuator.map_k1_pa_per_a", "actuator.natural_frequency_hz",
-             "actuator.damping_ratio")
+DEVIATING = (K.FLYWHEEL_INERTIA_KG_M2, K.DRAG_COEFF_N_S2_PER_M2, K.FRICTION_THETA1,
+             K.FRICTION_THETA2, K.FRICTION_THETA3, K.BRAKE_GAIN_N_M_PER_PA,
+             K.ACTUATOR_MAP_K1_PA_PER_A, K.ACTUATOR_NATURAL_FREQUENCY_HZ,
+             K.ACTUATOR_DAMPING_RATIO)
 """Parameters on which a real rig differs from its datasheet."""
 
-NOISE = {"sensors.pressure_noise_pa": 1.5e4, "sensors.speed_noise_rad_s": 0.1,
-         "sensors.force_noise_n": 100.0}
+NOISE = {K.SENSORS_PRESSURE_NOISE_PA: 1.5e4, K.SENSORS_SPEED_NOISE_RAD_S: 0.1,
+         K.SENSORS_FORCE_NOISE_N: 100.0}
 GENERATING_FILE = "generating-parameters.yaml"
 LIGHT_LOAD = 0.7
 LIGHT_BAR = (14, 21, 28)
@@ -59,7 +60,7 @@ def standard_scenarios(p: RigParameters, light: bool = False) -> dict[str, sc.Sc
     """The runs of a calibration campaign: those of the example campaigns (same names), and
     with ``light`` the constant-pressure stops at a lighter static load (`_light`, see
     LIGHT_BAR)."""
-    max_current = p.number("actuator.max_current_a")
+    max_current = p.number(K.ACTUATOR_MAX_CURRENT_A)
     standard = {
         "actuator_ramp": sc.actuator_test(p, sc.quasi_static_ramp(max_current), 20.0,
                                           "actuator_ramp"),
@@ -96,8 +97,8 @@ def _start_angle(params: RigParameters, rng: np.random.Generator) -> RigParamete
 
 def _light(params: RigParameters) -> RigParameters:
     """The set of a `_light` run: LIGHT_LOAD of the static load, from LIGHT_SPEED_M_S."""
-    return at_static_load(params, LIGHT_LOAD * params.number("loading.static_load_n")).replace(
-        {"rig_test.initial_speed_m_s": LIGHT_SPEED_M_S}, "a light run")
+    return at_static_load(params, LIGHT_LOAD * params.number(K.LOADING_STATIC_LOAD_N)).replace(
+        {K.RIG_TEST_INITIAL_SPEED_M_S: LIGHT_SPEED_M_S}, "a light run")
 
 
 def _loaded(params: RigParameters, name: str) -> RigParameters:
@@ -118,7 +119,7 @@ def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,
     written = []
     rig.to_yaml(folder / GENERATING_FILE)
     if logger.rate_hz is not None:
-        rig = rig.replace({"simulation.output_rate_hz": logger.rate_hz}, "the logger's rate")
+        rig = rig.replace({K.SIMULATION_OUTPUT_RATE_HZ: logger.rate_hz}, "the logger's rate")
     scenarios = standard_scenarios(rig, light)
     order = _campaign_order([n for n, s in scenarios.items() if s.contact
                              and (names is None or n in names)])

@@ -14,12 +14,13 @@ from landing_gear_sim.calibration.measured import simulate_all
 from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
 from landing_gear_sim.calibration.statistics import Estimate, covariance_std, run_weights
 from landing_gear_sim.errors import IdentificationError
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.elements import burckhardt_mu, slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import load_factor_at, rolling_radius_at
 from msg_tools.run import Run
 
-KEYS = ("friction.theta1", "friction.theta2", "friction.theta3")
+KEYS = (K.FRICTION_THETA1, K.FRICTION_THETA2, K.FRICTION_THETA3)
 REFINE_BOUNDS = (0.2, 5.0)  # output-error refinement stays within these factors of the start
 # its budget: a campaign the model fits converges in 4-6 steps; one with an effect the model
 # lacks crawled along a valley for 30+ (11 s of a diagnosis' calibration, for a curve the
@@ -50,7 +51,7 @@ def samples_at(b: Braking, p: RigParameters, idx: np.ndarray) -> tuple[np.ndarra
 def friction_indices(b: Braking, p: RigParameters) -> np.ndarray:
     """Samples of ``b`` (indices) that carry the friction curve: braking, loaded, the wheel
     turning, above the stop speed; at 100 Hz."""
-    stop = p.number("rig_test.stop_speed_m_s")
+    stop = p.number(K.RIG_TEST_STOP_SPEED_M_S)
     m = (b.time_s > b.start_s + 0.3) & (b.speed_m_s > stop + 2.0) & (b.load > LOADED_N) \
         & (b.wheel > 1.0)
     return np.flatnonzero(m)[::10]
@@ -107,7 +108,7 @@ def refine_friction(runs: Sequence[ClassifiedRun], p: RigParameters, jackknife: 
 
     def residual(theta: np.ndarray, chosen: Sequence[int]) -> np.ndarray:
         trial = p.replace(dict(zip(keys, theta * start, strict=True)), "identify")
-        ratio = trial.number("flywheel.radius_m") / trial.number("wheel.unloaded_radius_m")
+        ratio = trial.number(K.FLYWHEEL_RADIUS_M) / trial.number(K.WHEEL_UNLOADED_RADIUS_M)
         simulated = simulate_all([runs[i] for i in chosen], trial)
         return np.concatenate([weights[i] * slip_error(runs[i], sim, windows[i], ratio)
                                for i, sim in zip(chosen, simulated, strict=True)])

@@ -20,6 +20,7 @@ from landing_gear_sim.calibration.wheel_angle import (
     measured_angle_rad,
     run_phases,
 )
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.integrate import SimulationResult, simulate
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import at_static_load, rim_speed_m_s
@@ -61,8 +62,8 @@ def scenario_for_run(run: ClassifiedRun, params: RigParameters,
                     "measured input", wheel_angle_rad=wheel_angle_rad)
 
 
-GAIN = "brake.gain_n_m_per_pa"
-DRIFT = "brake.gain_drift_per_run"
+GAIN = K.BRAKE_GAIN_N_M_PER_PA
+DRIFT = K.BRAKE_GAIN_DRIFT_PER_RUN
 
 
 def run_parameters(params: RigParameters, campaign_order: float) -> RigParameters:
@@ -83,7 +84,7 @@ def run_static_load_n(run: ClassifiedRun, params: RigParameters) -> float | None
     if mask.sum() < STATIC_LOAD_SAMPLES:
         return None
     speed = rim_speed_m_s(params, run.flywheel_speed_rad_s[mask])
-    lift = params.number("loading.lift_coeff_n_s2_per_m2")
+    lift = params.number(K.LOADING_LIFT_COEFF_N_S2_PER_M2)
     return float(np.mean(run.vertical_load_n[mask] + lift * speed * speed))
 
 
@@ -93,7 +94,7 @@ def _at_run_load(params: RigParameters, run: ClassifiedRun) -> RigParameters:
     model's own when the run's is within SAME_LOAD of it (the estimate's few newtons of
     noise only perturbed the fits: a pressure slope moved by 4 %)."""
     load = run_static_load_n(run, params)
-    model = params.number("loading.static_load_n")
+    model = params.number(K.LOADING_STATIC_LOAD_N)
     if load is None or abs(load - model) <= SAME_LOAD * model:
         return params
     return at_static_load(params, load, "the run's static load")

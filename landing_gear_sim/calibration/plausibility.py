@@ -22,6 +22,7 @@ from scipy.integrate import trapezoid
 
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.errors import IdentificationError
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.actuator import actuator_pressure
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s, rolling_radius_at
@@ -187,7 +188,7 @@ def _check_momentum(run: ClassifiedRun, params: RigParameters) -> None:
         return
     span = slice(on[0], on[-1] + 1)
     omega = run.flywheel_speed_rad_s[span]
-    momentum = params.number("flywheel.inertia_kg_m2") / params.number("flywheel.radius_m") \
+    momentum = params.number(K.FLYWHEEL_INERTIA_KG_M2) / params.number(K.FLYWHEEL_RADIUS_M) \
         * (np.mean(omega[:EDGE_SAMPLES]) - np.mean(omega[-EDGE_SAMPLES:]))
     impulse = float(trapezoid(run.longitudinal_force_n[span], run.time_s[span]))
     ratio = abs(float(momentum) / impulse) if impulse else math.inf

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s
 from landing_gear_sim.model.scenario import brake_start_index, current_noise_a, denoised_command
@@ -241,4 +242,4 @@ def braking_window(run: ClassifiedRun, params: RigParameters) -> np.ndarray:
     """Samples from the brake application to where the rig is about to stop (mask (n,))."""
     speed = rim_speed_m_s(params, run.flywheel_speed_rad_s)
     return (run.time_s >= run.brake_start_s) & (
-        speed > params.number("rig_test.stop_speed_m_s") + 1.0)
+        speed > params.number(K.RIG_TEST_STOP_SPEED_M_S) + 1.0)

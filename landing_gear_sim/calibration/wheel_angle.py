@@ -29,6 +29,7 @@ import numpy as np
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.statistics import linear_std
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rolling_radius_at
 from landing_gear_sim.model.sensors import RUNOUT_KEYS, SensorModel, wheel_angle_rad
@@ -39,8 +40,8 @@ BEFORE_BRAKE_S = (1.0, 0.05)  # free rolling: from 1 s to 50 ms before the brake
 MIN_SPEED_RAD_S = 20.0  # slower, a revolution outlasts the window's trend
 MIN_SAMPLES = 200
 TREND = 3  # columns of the quadratic trend in time
-BRAKE_RUNOUT_KEYS = ("brake.runout_1", "brake.runout_1_phase_rad", "brake.runout_2",
-                     "brake.runout_2_phase_rad")  # amplitudes: br.RUNOUT_AMPLITUDES
+BRAKE_RUNOUT_KEYS = (K.BRAKE_RUNOUT_1, K.BRAKE_RUNOUT_1_PHASE_RAD, K.BRAKE_RUNOUT_2,
+                     K.BRAKE_RUNOUT_2_PHASE_RAD)  # amplitudes: br.RUNOUT_AMPLITUDES
 RIPPLE_FILTER_HZ = 150.0
 NYQUIST_SHARE = 0.8  # a slower log: low-passed at this share of its Nyquist frequency
 MAX_SLIP = 0.15  # beyond, a wheel on its way to lock: the torque balance's error dominates
@@ -136,7 +137,7 @@ def brake_ripple_design(run: ClassifiedRun, params: RigParameters,
     force = br.lowpass(sensors.true_longitudinal(run.longitudinal_force_n, run.vertical_load_n),
                        rate, cutoff)
     torque = rolling_radius_at(params, b.load) * force - params.number(
-        "wheel.inertia_kg_m2") * np.gradient(wheel, 1.0 / rate)
+        K.WHEEL_INERTIA_KG_M2) * np.gradient(wheel, 1.0 / rate)
     _, energy = br.torque_balance(b, params)
     mask = br.braking_samples(b) & (wheel > MIN_SPEED_RAD_S) & (br.slip(b, params) < MAX_SLIP)
     if mask.sum() < MIN_SAMPLES:

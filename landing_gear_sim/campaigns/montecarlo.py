@@ -24,6 +24,7 @@ from antiskid.closed_loop import SURFACES, controller_settings
 from antiskid.compiled import compiled_closed_loop
 from antiskid.metrics import braking_metrics
 from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.integrate import SimulationResult
 from landing_gear_sim.model.parameters import SPECS, RigParameters
 from landing_gear_sim.model.quantities import REFERENCE_LOAD, STATIC_LOAD, at_static_load
@@ -112,13 +113,13 @@ def draw_case(base: RigParameters, plan: Plan, index: int) -> Case:
     speed = float(rng.uniform(*plan.entry_speed_m_s))
     factor = float(rng.uniform(*plan.load_factor))
     overrides = _drawn_parameters(base, plan.sigma, rng)
-    overrides["rig_test.initial_speed_m_s"] = speed
+    overrides[K.RIG_TEST_INITIAL_SPEED_M_S] = speed
     overrides |= _static_load(base, factor)
     jump = math.nan
     if surface == "jump":
         after = str(rng.choice(sorted(SURFACES)))
         jump = float(rng.uniform(*plan.jump_speed_m_s))
-        overrides["friction.change_speed_m_s"] = jump
+        overrides[K.FRICTION_CHANGE_SPEED_M_S] = jump
         overrides |= {f"friction.after_{t}": v for t, v in zip(THETAS, SURFACES[after],
                                                                     strict=True)}
         surface = f"jump-{after}"

@@ -19,6 +19,7 @@ from landing_gear_sim.cli.common import (
     write_atomically,
 )
 from landing_gear_sim.errors import IdentificationError, LandingGearSimError
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters, parse_assignment
 from msg_tools.units import PA_PER_BAR
 
@@ -265,7 +266,7 @@ def cmd_antiskid(args: argparse.Namespace) -> int:
     check_outputs(files=[args.output, args.json, args.plot])
     rig = with_surface(params_of(args), args.surface)
     settings = dict(parse_assignment(text) for text in args.setting)
-    step_s = 1.0 / (args.rate or rig.number("simulation.output_rate_hz"))
+    step_s = 1.0 / (args.rate or rig.number(K.SIMULATION_OUTPUT_RATE_HZ))
     controller = make_controller(args.controller, rig, step_s, settings)
     progress(f"{args.controller} controller on the {args.surface} surface, closed loop")
     run = closed_loop(rig, controller, args.rate or 0.0).to_run()

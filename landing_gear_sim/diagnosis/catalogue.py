@@ -29,6 +29,7 @@ from landing_gear_sim.calibration.runs import (
 )
 from landing_gear_sim.calibration.statistics import covariance_std
 from landing_gear_sim.errors import IdentificationError
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import gear_walk_modes
 from msg_tools.run import Run
@@ -99,7 +100,7 @@ def fade_reach(values: dict[str, float], runs: Sequence[ClassifiedRun],
     700 MJ was once named; a stop absorbs a few MJ)."""
     energies = [float(br.torque_balance(br.prepare(r, params), params)[1][-1])
                 for r in runs if r.braking]
-    energy = values.get("brake.fade_energy_j", 0.0)
+    energy = values.get(K.BRAKE_FADE_ENERGY_J, 0.0)
     largest = max(energies, default=0.0)
     if energy <= FADE_REACH * largest:
         return ""
@@ -108,31 +109,31 @@ def fade_reach(values: dict[str, float], runs: Sequence[ClassifiedRun],
             "of a law in brake energy, not a fade")
 
 
-ACTUATOR = ("actuator.natural_frequency_hz", "actuator.damping_ratio")
-FRICTION = ("friction.theta1", "friction.theta2", "friction.theta3")
-STATIC_MAP = ("actuator.deadband_current_a", "actuator.map_k1_pa_per_a",
-              "actuator.map_k2_pa_per_a2", "actuator.max_pressure_pa")
-GEAR_WALK = ("gear_walk.stiffness_n_m_per_rad", "gear_walk.damping_n_m_s_per_rad")
+ACTUATOR = (K.ACTUATOR_NATURAL_FREQUENCY_HZ, K.ACTUATOR_DAMPING_RATIO)
+FRICTION = (K.FRICTION_THETA1, K.FRICTION_THETA2, K.FRICTION_THETA3)
+STATIC_MAP = (K.ACTUATOR_DEADBAND_CURRENT_A, K.ACTUATOR_MAP_K1_PA_PER_A,
+              K.ACTUATOR_MAP_K2_PA_PER_A2, K.ACTUATOR_MAX_PRESSURE_PA)
+GEAR_WALK = (K.GEAR_WALK_STIFFNESS_N_M_PER_RAD, K.GEAR_WALK_DAMPING_N_M_S_PER_RAD)
 PRESSURE = ("pressure_pa",)
 WHEEL = ("wheel_speed_rad_s", "longitudinal_force_n")
-FADE = ("brake.fade_fraction", "brake.fade_energy_j")
+FADE = (K.BRAKE_FADE_FRACTION, K.BRAKE_FADE_ENERGY_J)
 ACTUATOR_RUNS: tuple[Selector, ...] = (Family.ACTUATOR,)
 BRAKE_RUNS: tuple[Selector, ...] = (Family.BRAKE,)
 
 CATALOGUE: dict[str, Candidate] = {c.cause: c for c in (
     # an actuator effect shows in every run's pressure: fitted on the actuator runs,
     # checked on the braking runs' pressure
-    Candidate(cause="actuator_delay", element="actuator_delay", keys=("actuator.delay_s",),
+    Candidate(cause="actuator_delay", element="actuator_delay", keys=(K.ACTUATOR_DELAY_S,),
               starts=((0.002,), (0.006,), (0.012,), (0.025,)), bounds=((0.0, 0.06),),
               free=ACTUATOR, runs=ACTUATOR_RUNS, channels=PRESSURE, held_out=BRAKE_RUNS,
-              contract=(("delay_s", "actuator.delay_s"),)),
+              contract=(("delay_s", K.ACTUATOR_DELAY_S),)),
     # an offset shifts the whole map while calibrating it: re-fit the map with it; the
     # stretches below the dead-band tell the two apart
     Candidate(cause="pressure_sensor_offset", element="pressure_sensor_offset",
-              keys=("sensors.pressure_offset_pa",), starts=((0.0,),),
+              keys=(K.SENSORS_PRESSURE_OFFSET_PA,), starts=((0.0,),),
               bounds=((-10 * PA_PER_BAR, 10 * PA_PER_BAR),), free=STATIC_MAP,
               runs=ACTUATOR_RUNS, channels=PRESSURE, held_out=BRAKE_RUNS,
-              contract=(("offset_pa", "sensors.pressure_offset_pa"),)),
+              contract=(("offset_pa", K.SENSORS_PRESSURE_OFFSET_PA),)),
     Candidate(cause="actuator_dynamics", element="actuator_dynamics", keys=ACTUATOR,
               starts=((8.0, 0.5), (15.0, 0.8)), bounds=((1.0, 60.0), (0.1, 2.0)), free=(),
               runs=ACTUATOR_RUNS, channels=PRESSURE, held_out=BRAKE_RUNS,
@@ -142,10 +143,10 @@ CATALOGUE: dict[str, Candidate] = {c.cause: c for c in (
     # skid and the output error jumps with the exact moment (a fit there got stuck at
     # 2/3 of the true length, in a valley of width ~1 %)
     Candidate(cause="tire_relaxation", element="tire_relaxation",
-              keys=("tyre.relaxation_length_m",), starts=((0.1,), (0.4,), (1.0,)),
+              keys=(K.TYRE_RELAXATION_LENGTH_M,), starts=((0.1,), (0.4,), (1.0,)),
               bounds=((0.005, 5.0),), free=FRICTION, runs=(RunKind.BRAKE_CONSTANT,),
               channels=WHEEL, held_out=(),
-              contract=(("relaxation_length_m", "tyre.relaxation_length_m"),)),
+              contract=(("relaxation_length_m", K.TYRE_RELAXATION_LENGTH_M),)),
     Candidate(cause="gear_walk", element="gear_walk", keys=GEAR_WALK,
               starts=((6.9e5, 1372.0), (3e5, 1000.0), (1.5e6, 2000.0)),
               bounds=((5e4, 2e7), (10.0, 5e4)), free=FRICTION, runs=BRAKE_RUNS,
@@ -153,26 +154,26 @@ CATALOGUE: dict[str, Candidate] = {c.cause: c for c in (
     Candidate(cause="brake_fade", element="brake_fade", keys=FADE,
               starts=((0.1, 2e6), (0.3, 5e5)), bounds=((0.0, 0.9), (1e4, 1e8)),
               # the calibration bent the friction curve to absorb the fade: free it too
-              free=("brake.gain_n_m_per_pa", *FRICTION), runs=BRAKE_RUNS,
+              free=(K.BRAKE_GAIN_N_M_PER_PA, *FRICTION), runs=BRAKE_RUNS,
               # the measured force is the brake torque over r whatever the friction
               # curve (which the calibration distorted to absorb the fade)
               channels=("longitudinal_force_n", "flywheel_speed_rad_s"), held_out=(),
               contract=(("fade_fraction", FADE[0]), ("fade_energy_j", FADE[1]),
-                        ("gain_n_m_per_pa", "brake.gain_n_m_per_pa"),
-                        ("fade_shape", "brake.fade_shape")), reach=fade_reach),
-    Candidate(cause="drag", element="drag", keys=("drag.coeff_n_s2_per_m2",),
-              starts=((0.2,),), bounds=((0.0, 5.0),), free=("flywheel.inertia_kg_m2",),
+                        ("gain_n_m_per_pa", K.BRAKE_GAIN_N_M_PER_PA),
+                        ("fade_shape", K.BRAKE_FADE_SHAPE)), reach=fade_reach),
+    Candidate(cause="drag", element="drag", keys=(K.DRAG_COEFF_N_S2_PER_M2,),
+              starts=((0.2,),), bounds=((0.0, 5.0),), free=(K.FLYWHEEL_INERTIA_KG_M2,),
               runs=BRAKE_RUNS, channels=("flywheel_speed_rad_s",), held_out=(),
-              contract=(("drag_coeff_n_s2_per_m2", "drag.coeff_n_s2_per_m2"),)),
+              contract=(("drag_coeff_n_s2_per_m2", K.DRAG_COEFF_N_S2_PER_M2),)),
     Candidate(cause="load_dependent_radius", element="load_dependent_radius",
-              keys=("radius.a_m_per_n2", "radius.b_m_per_n"), starts=((4e-12, 5e-7),),
+              keys=(K.RADIUS_A_M_PER_N2, K.RADIUS_B_M_PER_N), starts=((4e-12, 5e-7),),
               bounds=((0.0, 1e-10), (0.0, 5e-6)),
               # without the element the calibration bent the friction curve (slip read
               # with one radius at every load): free it too
-              free=("wheel.unloaded_radius_m", "brake.gain_n_m_per_pa", *FRICTION),
+              free=(K.WHEEL_UNLOADED_RADIUS_M, K.BRAKE_GAIN_N_M_PER_PA, *FRICTION),
               runs=BRAKE_RUNS, channels=WHEEL, held_out=(),
-              contract=(("radius_a_m_per_n2", "radius.a_m_per_n2"),
-                        ("radius_b_m_per_n", "radius.b_m_per_n"))),
+              contract=(("radius_a_m_per_n2", K.RADIUS_A_M_PER_N2),
+                        ("radius_b_m_per_n", K.RADIUS_B_M_PER_N))),
     Candidate(cause="friction_curve", element=None, keys=FRICTION, starts=(),
               bounds=((0.05, 3.0), (1.0, 300.0), (0.0, 2.0)), free=(), runs=BRAKE_RUNS,
               channels=WHEEL, held_out=(),
@@ -288,9 +289,9 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
     best = _optimise(residual, start, MAX_ITERATIONS)
     values = window.value(best.x)
     std = covariance_std(best, len(keys)) * window.slope(best.x)
-    if "actuator.delay_s" in keys:
-        std[keys.index("actuator.delay_s")] = math.hypot(
-            std[keys.index("actuator.delay_s")], input_timing_std_s(chosen))
+    if K.ACTUATOR_DELAY_S in keys:
+        std[keys.index(K.ACTUATOR_DELAY_S)] = math.hypot(
+            std[keys.index(K.ACTUATOR_DELAY_S)], input_timing_std_s(chosen))
     fitted = model.replace(dict(zip(keys, values, strict=True)), f"fit {candidate.cause}")
     return CandidateFit(candidate, fitted, dict(zip(keys, map(float, values), strict=True)),
                         dict(zip(keys, map(float, std), strict=True)), best.fun)

@@ -60,6 +60,7 @@ from landing_gear_sim.diagnosis.relations import (
     Relation,
 )
 from landing_gear_sim.diagnosis.scoring import effective_count
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.actuator import actuator_pressure
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rolling_radius_at
@@ -188,7 +189,7 @@ def _valve_direction(run: ClassifiedRun, params: RigParameters) -> Check | None:
     fast = np.abs(change) > SLOW_A_S
     slow = np.convolve(fast, np.ones(window), mode="full")[:fast.size] == 0
     band = (model > 2 * PRESSURE_FLOOR_PA) & (model < 0.9 * params.number(
-        "actuator.max_pressure_pa"))
+        K.ACTUATOR_MAX_PRESSURE_PA))
     falling, rising = (residual[slow & band & (direction == s)] for s in (-1.0, 1.0))
     if min(falling.size, rising.size) < MIN_CHECK_S * run.rate_hz:
         return None
@@ -283,7 +284,7 @@ def free_rolling_excess(b: br.Braking, params: RigParameters) -> tuple[np.ndarra
     reads beyond the physics."""
     m = br.free_rolling(b)
     radius = rolling_radius_at(params, b.load[m])
-    inertia = params.number("wheel.inertia_kg_m2") * b.wheel_rate[m] / radius
+    inertia = params.number(K.WHEEL_INERTIA_KG_M2) * b.wheel_rate[m] / radius
     force = SensorModel.of(params).true_longitudinal(b.run.longitudinal_force_n[m],
                                                      b.run.vertical_load_n[m])
     return m, force - inertia
@@ -299,7 +300,7 @@ def _gain_trends(runs: Sequence[br.Braking], params: RigParameters) -> list[Chec
     """k_b of the torque balance with a linear trend in speed, and in pressure, over the
     braking runs: the relative change over the range seen [1]."""
     torque, pressure, speed = [], [], []
-    gain = params.number("brake.gain_n_m_per_pa")
+    gain = params.number(K.BRAKE_GAIN_N_M_PER_PA)
     for b in runs:
         whole, energy = br.torque_balance(b, params)
         m = np.flatnonzero(br.steady_braking_samples(b))[::10]

@@ -20,6 +20,7 @@ from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
 from landing_gear_sim.diagnosis import residuals as rs
 from landing_gear_sim.diagnosis.equations import Place
 from landing_gear_sim.diagnosis.findings import Finding, Signature, SignatureKind
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.elements import slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s
@@ -52,7 +53,7 @@ def _regressors(run: Run, model: Run, params: RigParameters) -> dict[str, np.nda
     where the wheel speed enters, the ``model``'s simulation of it does."""
     speed = rim_speed_m_s(params, run.flywheel_speed_rad_s)
     wheel = model.wheel_speed_rad_s
-    slip = slip_ratio(speed, wheel, params.number("wheel.unloaded_radius_m"))
+    slip = slip_ratio(speed, wheel, params.number(K.WHEEL_UNLOADED_RADIUS_M))
     smooth_pressure = np.convolve(run.pressure_pa, np.ones(20) / 20, mode="same")
     energy = np.cumsum(np.clip(run.pressure_pa, 0, None) * np.clip(wheel, 0, None))
     return {"vertical load": run.vertical_load_n, "speed": speed,

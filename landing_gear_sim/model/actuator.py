@@ -18,13 +18,14 @@ import scipy.linalg
 from numba import njit
 
 from landing_gear_sim.model import elements as el
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import INDEX, RigParameters
 
-_ACT_GAIN = INDEX["actuator.gain"]
-_ACT_WN = INDEX["actuator.natural_frequency_hz"]
-_ACT_ZETA = INDEX["actuator.damping_ratio"]
-_ACT_DELAY = INDEX["actuator.delay_s"]
-_BACKLASH = INDEX["actuator.backlash_a"]
+_ACT_GAIN = INDEX[K.ACTUATOR_GAIN]
+_ACT_WN = INDEX[K.ACTUATOR_NATURAL_FREQUENCY_HZ]
+_ACT_ZETA = INDEX[K.ACTUATOR_DAMPING_RATIO]
+_ACT_DELAY = INDEX[K.ACTUATOR_DELAY_S]
+_BACKLASH = INDEX[K.ACTUATOR_BACKLASH_A]
 PLAY = 2  # actuator state: pressure, rate, the current the valve sees, static pressures
 
 
@@ -50,9 +51,9 @@ def second_order_response(frequency_hz: np.ndarray, natural_frequency_hz: float,
 
 def actuator_system(params: RigParameters) -> tuple[np.ndarray, np.ndarray]:
     """A(s) of a parameter set (see :func:`second_order_system`)."""
-    return second_order_system(params.number("actuator.natural_frequency_hz"),
-                               params.number("actuator.damping_ratio"),
-                               params.number("actuator.gain"))
+    return second_order_system(params.number(K.ACTUATOR_NATURAL_FREQUENCY_HZ),
+                               params.number(K.ACTUATOR_DAMPING_RATIO),
+                               params.number(K.ACTUATOR_GAIN))
 
 
 def _zoh(a: np.ndarray, b: np.ndarray, span_s: float) -> tuple[np.ndarray, np.ndarray]:

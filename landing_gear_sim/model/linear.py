@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from landing_gear_sim.model import elements as el
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.plant import (
     ANGLE,
@@ -78,16 +79,16 @@ def operating_point(params: RigParameters, speed_m_s: float, slip: float = 0.05)
     force = load * el.tyre_friction(p, slip, speed_m_s, load)
     x[TYRE_FORCE] = force
     if params.has("gear_walk"):
-        x[ANGLE] = params.number("gear_walk.length_m") * force / params.number(
-            "gear_walk.stiffness_n_m_per_rad")
-    pressure = radius * force / params.number("brake.gain_n_m_per_pa")
+        x[ANGLE] = params.number(K.GEAR_WALK_LENGTH_M) * force / params.number(
+            K.GEAR_WALK_STIFFNESS_N_M_PER_RAD)
+    pressure = radius * force / params.number(K.BRAKE_GAIN_N_M_PER_PA)
     return OperatingPoint(speed_m_s, slip, load, pressure, x)
 
 
 def linearise(params: RigParameters, point: OperatingPoint) -> LinearModel:
     """Central-difference Jacobians of the plant at ``point``, speed frozen."""
     p = params.vector()
-    gain = params.number("brake.gain_n_m_per_pa")
+    gain = params.number(K.BRAKE_GAIN_N_M_PER_PA)
     states = list(linear_states(params))
     steps = {ANGLE: 1e-6, ANGLE_RATE: 1e-5, OMEGA: 1e-5 * max(point.state[OMEGA], 1.0),
              TYRE_FORCE: 1e-3 * max(abs(point.state[TYRE_FORCE]), 1.0)}

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import yaml
 
 from landing_gear_sim.errors import ParameterError
+from landing_gear_sim.model import keys as K
 
 if TYPE_CHECKING:
     import numpy as np
@@ -65,107 +66,107 @@ def _ripple(prefix: str, law: str, cause: str, read_from: str) -> tuple[ParamSpe
 
 
 SPECS: tuple[ParamSpec, ...] = (
-    ParamSpec("configuration", "-", "rig (flywheel) or aircraft (eqs. 5-6)", "choice",
+    ParamSpec(K.CONFIGURATION, "-", "rig (flywheel) or aircraft (eqs. 5-6)", "choice",
               choices=CONFIGURATIONS),
     *(ParamSpec(f"elements.{name}", "-", f"{name} element switched on", "bool")
       for name in ELEMENTS),
-    _f("flywheel.radius_m", "m", "flywheel radius R_f"),
-    _f("flywheel.inertia_kg_m2", "kg m^2", "flywheel inertia J_f"),
-    _f("drag.coeff_n_s2_per_m2", "N s^2/m^2", "drag coefficient alpha_d", positive=False),
-    _f("wheel.unloaded_radius_m", "m", "unloaded tyre radius r0"),
-    _f("wheel.inertia_kg_m2", "kg m^2", "wheel inertia J_w"),
-    _f("radius.a_m_per_n2", "m/N^2", "radius reduction, quadratic term a", positive=False),
-    _f("radius.b_m_per_n", "m/N", "radius reduction, linear term b", positive=False),
-    _f("radius.c_m", "m", "radius reduction, constant term c", positive=False),
-    _f("friction.theta1", "-", "Burckhardt theta1"),
-    _f("friction.theta2", "-", "Burckhardt theta2"),
-    _f("friction.theta3", "-", "Burckhardt theta3", positive=False),
-    _f("gear_walk.length_m", "m", "gear-walk lever L_gw"),
-    _f("gear_walk.inertia_kg_m2", "kg m^2", "gear inertia about the attachment"),
-    _f("gear_walk.stiffness_n_m_per_rad", "N m/rad", "gear-walk stiffness k_theta"),
-    _f("gear_walk.damping_n_m_s_per_rad", "N m s/rad", "gear-walk damping c_theta",
+    _f(K.FLYWHEEL_RADIUS_M, "m", "flywheel radius R_f"),
+    _f(K.FLYWHEEL_INERTIA_KG_M2, "kg m^2", "flywheel inertia J_f"),
+    _f(K.DRAG_COEFF_N_S2_PER_M2, "N s^2/m^2", "drag coefficient alpha_d", positive=False),
+    _f(K.WHEEL_UNLOADED_RADIUS_M, "m", "unloaded tyre radius r0"),
+    _f(K.WHEEL_INERTIA_KG_M2, "kg m^2", "wheel inertia J_w"),
+    _f(K.RADIUS_A_M_PER_N2, "m/N^2", "radius reduction, quadratic term a", positive=False),
+    _f(K.RADIUS_B_M_PER_N, "m/N", "radius reduction, linear term b", positive=False),
+    _f(K.RADIUS_C_M, "m", "radius reduction, constant term c", positive=False),
+    _f(K.FRICTION_THETA1, "-", "Burckhardt theta1"),
+    _f(K.FRICTION_THETA2, "-", "Burckhardt theta2"),
+    _f(K.FRICTION_THETA3, "-", "Burckhardt theta3", positive=False),
+    _f(K.GEAR_WALK_LENGTH_M, "m", "gear-walk lever L_gw"),
+    _f(K.GEAR_WALK_INERTIA_KG_M2, "kg m^2", "gear inertia about the attachment"),
+    _f(K.GEAR_WALK_STIFFNESS_N_M_PER_RAD, "N m/rad", "gear-walk stiffness k_theta"),
+    _f(K.GEAR_WALK_DAMPING_N_M_S_PER_RAD, "N m s/rad", "gear-walk damping c_theta",
        positive=False),
-    _f("aircraft.mass_kg", "kg", "aircraft mass share on this wheel m_a"),
-    _f("aircraft.wheel_mass_kg", "kg", "wheel mass m_w", positive=False),
-    _f("aircraft.gear_mass_kg", "kg", "gear mass m_gw", positive=False),
-    _f("brake.gain_n_m_per_pa", "N m/Pa", "brake gain k_b = mu_b A_p R_eff n_s"),
-    _f("brake.fade_fraction", "-", "gain lost when fully faded (brake_fade)", positive=False),
-    _f("brake.fade_energy_j", "J", "brake energy scale of the fade (brake_fade)"),
-    _f("tyre.relaxation_length_m", "m", "tyre relaxation length (tire_relaxation)",
+    _f(K.AIRCRAFT_MASS_KG, "kg", "aircraft mass share on this wheel m_a"),
+    _f(K.AIRCRAFT_WHEEL_MASS_KG, "kg", "wheel mass m_w", positive=False),
+    _f(K.AIRCRAFT_GEAR_MASS_KG, "kg", "gear mass m_gw", positive=False),
+    _f(K.BRAKE_GAIN_N_M_PER_PA, "N m/Pa", "brake gain k_b = mu_b A_p R_eff n_s"),
+    _f(K.BRAKE_FADE_FRACTION, "-", "gain lost when fully faded (brake_fade)", positive=False),
+    _f(K.BRAKE_FADE_ENERGY_J, "J", "brake energy scale of the fade (brake_fade)"),
+    _f(K.TYRE_RELAXATION_LENGTH_M, "m", "tyre relaxation length (tire_relaxation)",
        positive=False),
-    _f("actuator.max_current_a", "A", "valve current range upper limit"),
-    _f("actuator.deadband_current_a", "A", "static map dead-band I0", positive=False),
-    _f("actuator.map_k1_pa_per_a", "Pa/A", "static map linear gain k1"),
-    _f("actuator.map_k2_pa_per_a2", "Pa/A^2", "static map curvature k2", positive=False),
-    _f("actuator.max_pressure_pa", "Pa", "static map saturation P_max"),
-    _f("actuator.gain", "-", "A(s) static gain"),
-    _f("actuator.natural_frequency_hz", "Hz", "A(s) natural frequency"),
-    _f("actuator.damping_ratio", "-", "A(s) damping ratio"),
-    _f("actuator.delay_s", "s", "transport delay current -> pressure (actuator_delay)",
+    _f(K.ACTUATOR_MAX_CURRENT_A, "A", "valve current range upper limit"),
+    _f(K.ACTUATOR_DEADBAND_CURRENT_A, "A", "static map dead-band I0", positive=False),
+    _f(K.ACTUATOR_MAP_K1_PA_PER_A, "Pa/A", "static map linear gain k1"),
+    _f(K.ACTUATOR_MAP_K2_PA_PER_A2, "Pa/A^2", "static map curvature k2", positive=False),
+    _f(K.ACTUATOR_MAX_PRESSURE_PA, "Pa", "static map saturation P_max"),
+    _f(K.ACTUATOR_GAIN, "-", "A(s) static gain"),
+    _f(K.ACTUATOR_NATURAL_FREQUENCY_HZ, "Hz", "A(s) natural frequency"),
+    _f(K.ACTUATOR_DAMPING_RATIO, "-", "A(s) damping ratio"),
+    _f(K.ACTUATOR_DELAY_S, "s", "transport delay current -> pressure (actuator_delay)",
        positive=False),
-    _f("loading.static_load_n", "N", "vertical load at zero speed F_z0"),
-    _f("loading.lift_coeff_n_s2_per_m2", "N s^2/m^2", "lift coefficient k_L", positive=False),
-    _f("loading.servo_time_constant_s", "s", "loading-device servo time constant"),
-    _f("loading.touchdown_ramp_s", "s", "load ramp duration at touch-down", positive=False),
-    _f("rig_test.initial_speed_m_s", "m/s", "flywheel rim speed at the start v0",
+    _f(K.LOADING_STATIC_LOAD_N, "N", "vertical load at zero speed F_z0"),
+    _f(K.LOADING_LIFT_COEFF_N_S2_PER_M2, "N s^2/m^2", "lift coefficient k_L", positive=False),
+    _f(K.LOADING_SERVO_TIME_CONSTANT_S, "s", "loading-device servo time constant"),
+    _f(K.LOADING_TOUCHDOWN_RAMP_S, "s", "load ramp duration at touch-down", positive=False),
+    _f(K.RIG_TEST_INITIAL_SPEED_M_S, "m/s", "flywheel rim speed at the start v0",
        positive=False),
-    _f("rig_test.touchdown_s", "s", "touch-down time", positive=False),
-    _f("rig_test.brake_start_s", "s", "braking starts t_brake", positive=False),
-    _f("rig_test.brake_ramp_s", "s", "current ramp-in at braking start", positive=False),
-    _f("rig_test.stop_speed_m_s", "m/s", "run stops when the flywheel is slower",
+    _f(K.RIG_TEST_TOUCHDOWN_S, "s", "touch-down time", positive=False),
+    _f(K.RIG_TEST_BRAKE_START_S, "s", "braking starts t_brake", positive=False),
+    _f(K.RIG_TEST_BRAKE_RAMP_S, "s", "current ramp-in at braking start", positive=False),
+    _f(K.RIG_TEST_STOP_SPEED_M_S, "m/s", "run stops when the flywheel is slower",
        positive=False),
-    _f("rig_test.max_duration_s", "s", "longest run"),
-    _f("sensors.pressure_noise_pa", "Pa", "pressure transducer noise std", positive=False),
-    _f("sensors.speed_noise_rad_s", "rad/s", "encoder noise std", positive=False),
-    _f("sensors.force_noise_n", "N", "load-cell noise std", positive=False),
-    ParamSpec("sensors.pressure_offset_pa", "Pa",
+    _f(K.RIG_TEST_MAX_DURATION_S, "s", "longest run"),
+    _f(K.SENSORS_PRESSURE_NOISE_PA, "Pa", "pressure transducer noise std", positive=False),
+    _f(K.SENSORS_SPEED_NOISE_RAD_S, "rad/s", "encoder noise std", positive=False),
+    _f(K.SENSORS_FORCE_NOISE_N, "N", "load-cell noise std", positive=False),
+    ParamSpec(K.SENSORS_PRESSURE_OFFSET_PA, "Pa",
               "pressure transducer offset (pressure_sensor_offset)", signed=True),
-    _f("simulation.output_rate_hz", "Hz", "output (and input hold) rate"),
+    _f(K.SIMULATION_OUTPUT_RATE_HZ, "Hz", "output (and input hold) rate"),
     # new keys go last: the compiled physics caches each module with the indices it saw,
     # and a module that did not change is not recompiled (shifted indices = wrong physics)
-    ParamSpec("brake.gain_slope_wheel_speed_s_per_rad", "s/rad",
+    ParamSpec(K.BRAKE_GAIN_SLOPE_WHEEL_SPEED_S_PER_RAD, "s/rad",
               "relative change of k_b per rad/s of wheel speed (a term the catalogue lacks; "
               "0: none)", signed=True, default=0.0),
-    ParamSpec("brake.gain_slope_pressure_per_pa", "1/Pa",
+    ParamSpec(K.BRAKE_GAIN_SLOPE_PRESSURE_PER_PA, "1/Pa",
               "relative change of k_b per Pa of brake pressure (torque not linear in "
               "pressure; 0: none)", signed=True, default=0.0),
-    ParamSpec("sensors.crosstalk_fx_per_fz", "-",
+    ParamSpec(K.SENSORS_CROSSTALK_FX_PER_FZ, "-",
               "fraction of the vertical load the longitudinal load-cell channel reads "
               "(a channel that is not clean; 0: none)", signed=True, default=0.0),
-    ParamSpec("sensors.wheel_speed_delay_s", "s",
+    ParamSpec(K.SENSORS_WHEEL_SPEED_DELAY_S, "s",
               "the wheel-speed channel reads the wheel this much earlier than the others are "
               "read (a logger channel out of step; 0: none)", default=0.0),
-    ParamSpec("friction.change_speed_m_s", "m/s",
+    ParamSpec(K.FRICTION_CHANGE_SPEED_M_S, "m/s",
               "below this vehicle speed the tyre runs on a second surface, friction.after_* "
               "(a mu-jump mid-stop: a wet or icy patch; 0: one surface)", default=0.0),
-    ParamSpec("friction.after_theta1", "-", "Burckhardt theta1 of the second surface",
+    ParamSpec(K.FRICTION_AFTER_THETA1, "-", "Burckhardt theta1 of the second surface",
               default=0.0),
-    ParamSpec("friction.after_theta2", "-", "Burckhardt theta2 of the second surface",
+    ParamSpec(K.FRICTION_AFTER_THETA2, "-", "Burckhardt theta2 of the second surface",
               default=0.0),
-    ParamSpec("friction.after_theta3", "-", "Burckhardt theta3 of the second surface",
+    ParamSpec(K.FRICTION_AFTER_THETA3, "-", "Burckhardt theta3 of the second surface",
               default=0.0),
-    ParamSpec("actuator.backlash_a", "A",
+    ParamSpec(K.ACTUATOR_BACKLASH_A, "A",
               "play of the valve in current: the static map sees the current only once it "
               "has moved this much the other way (a hysteresis the catalogue lacks; 0: none)",
               default=0.0),
-    ParamSpec("brake.gain_drift_per_run", "-",
+    ParamSpec(K.BRAKE_GAIN_DRIFT_PER_RUN, "-",
               "relative change of k_b from one braking run of a campaign to the next, in run "
               "order, about the middle run (wear; a campaign-level term: a run simulated on "
               "its own has the middle run's k_b; 0: none)", signed=True, default=0.0),
-    ParamSpec("friction.load_sensitivity_per_n", "1/N",
+    ParamSpec(K.FRICTION_LOAD_SENSITIVITY_PER_N, "1/N",
               "relative change of mu per N of vertical load above friction.reference_load_n: "
               "mu = mu_B(slip) (1 - kappa (F_z - F_ref)) (a tyre's load sensitivity; 0: none)",
               signed=True, default=0.0),
-    ParamSpec("friction.reference_load_n", "N",
+    ParamSpec(K.FRICTION_REFERENCE_LOAD_N, "N",
               "vertical load at which the friction curve mu_B holds (0: at "
               "loading.static_load_n); a run at another static load keeps it", default=0.0),
     *_ripple("sensors.wheel_runout", "the wheel encoder reads omega", "run-out, an "
              "out-of-round code wheel", "its wheel channel"),
-    ParamSpec("brake.fade_shape", "-",
+    ParamSpec(K.BRAKE_FADE_SHAPE, "-",
               "shape s of the fade (brake_fade): k_b (1 - fraction g(E/energy)), g(x) = 1 - (1 + "
               "s x)^(-1/s); 0: the exponential 1 - exp(-x), 1: the hyperbola x/(1 + x); the "
               "same first slope for every s", default=0.0),
-    ParamSpec("sensors.pressure_delay_s", "s",
+    ParamSpec(K.SENSORS_PRESSURE_DELAY_S, "s",
               "the pressure channel reads the pressure this much earlier than the others are "
               "read (a logger channel out of step; 0: none)", default=0.0),
     *_ripple("brake.runout", "the brake torque is k_b P", "a disc's run-out, thickness "
@@ -238,7 +239,7 @@ class RigParameters:
 
     @property
     def configuration(self) -> str:
-        return str(self.values["configuration"])
+        return str(self.values[K.CONFIGURATION])
 
     def replace(self, overrides: Mapping[str, Value], source: str = "override") -> RigParameters:
         """A copy with some values changed (validated like a file)."""
@@ -379,7 +380,7 @@ def _check_known(values: Iterable[str], source: str) -> None:
             raise ParameterError(f"{source}: unknown parameter {key!r}{suggestion}")
 
 
-_NEEDS_POSITIVE = {"tire_relaxation": "tyre.relaxation_length_m"}
+_NEEDS_POSITIVE = {"tire_relaxation": K.TYRE_RELAXATION_LENGTH_M}
 """An element that is on needs this parameter > 0."""
 
 
@@ -399,7 +400,7 @@ def _check_values(values: Mapping[str, Any], origin: Mapping[str, str],
             where = origin.get(key) or ", ".join(sources) or "parameters"
             raise ParameterError(f"{where}: parameter {key!r} must be > 0 when "
                                  f"elements.{element} is true")
-    if values["brake.fade_fraction"] >= 1:
+    if values[K.BRAKE_FADE_FRACTION] >= 1:
         raise ParameterError(f"{origin.get('brake.fade_fraction') or ', '.join(sources)}: "
                              "parameter 'brake.fade_fraction' must be < 1")
 

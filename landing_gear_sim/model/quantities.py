@@ -12,6 +12,7 @@ from typing import TypeVar
 import numpy as np
 
 from landing_gear_sim.model import elements as el
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 
 Value = TypeVar("Value", float, np.ndarray)
@@ -53,12 +54,12 @@ def peak_friction(params: RigParameters) -> tuple[float, float]:
 
 def rim_speed_m_s(params: RigParameters, flywheel_speed_rad_s: Value) -> Value:
     """Flywheel rim (vehicle) speed ω_f R_f [m/s] from the flywheel encoder [rad/s]."""
-    return flywheel_speed_rad_s * params.number("flywheel.radius_m")
+    return flywheel_speed_rad_s * params.number(K.FLYWHEEL_RADIUS_M)
 
 
 def flywheel_speed_rad_s(params: RigParameters, rim_speed: Value) -> Value:
     """Flywheel encoder speed [rad/s] of a rim speed [m/s] (inverse of rim_speed_m_s)."""
-    return rim_speed / params.number("flywheel.radius_m")
+    return rim_speed / params.number(K.FLYWHEEL_RADIUS_M)
 
 
 def slip_at(params: RigParameters, vehicle_speed_m_s: np.ndarray,
@@ -72,14 +73,14 @@ def slip_at(params: RigParameters, vehicle_speed_m_s: np.ndarray,
 
 def gear_walk_modes(params: RigParameters) -> tuple[float, float]:
     """Gear alone: natural frequency √(k_θ/J)/2π [Hz] and damping ratio c_θ/(2√(k_θ J))."""
-    k = params.number("gear_walk.stiffness_n_m_per_rad")
-    j = params.number("gear_walk.inertia_kg_m2")
-    c = params.number("gear_walk.damping_n_m_s_per_rad")
+    k = params.number(K.GEAR_WALK_STIFFNESS_N_M_PER_RAD)
+    j = params.number(K.GEAR_WALK_INERTIA_KG_M2)
+    c = params.number(K.GEAR_WALK_DAMPING_N_M_S_PER_RAD)
     return math.sqrt(k / j) / (2 * math.pi), c / (2 * math.sqrt(k * j))
 
 
-STATIC_LOAD = "loading.static_load_n"
-REFERENCE_LOAD = "friction.reference_load_n"
+STATIC_LOAD = K.LOADING_STATIC_LOAD_N
+REFERENCE_LOAD = K.FRICTION_REFERENCE_LOAD_N
 
 
 def reference_load_n(params: RigParameters) -> float:

@@ -18,6 +18,7 @@ from scipy.integrate import solve_ivp
 
 from landing_gear_sim.errors import ParameterError
 from landing_gear_sim.model import elements as el
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.actuator import actuator_system
 from landing_gear_sim.model.parameters import INDEX, RigParameters
 from landing_gear_sim.model.plant import (
@@ -46,16 +47,16 @@ def reference_solution(params: RigParameters, scenario: Scenario, end_s: float |
     _check_modelled(params)
     p = params.vector()
     act_a, act_b = actuator_system(params)
-    wn = 2 * np.pi * params.number("actuator.natural_frequency_hz")
-    tau = p[INDEX["loading.servo_time_constant_s"]]
+    wn = 2 * np.pi * params.number(K.ACTUATOR_NATURAL_FREQUENCY_HZ)
+    tau = p[INDEX[K.LOADING_SERVO_TIME_CONSTANT_S]]
     x, dx = np.zeros(N_STATES), np.zeros(N_STATES)
-    p_max = p[INDEX["actuator.max_pressure_pa"]]
+    p_max = p[INDEX[K.ACTUATOR_MAX_PRESSURE_PA]]
     v_max = max(scenario.initial_speed_m_s, 1.0)
-    load = p[INDEX["loading.static_load_n"]]
+    load = p[INDEX[K.LOADING_STATIC_LOAD_N]]
     # Only states that act: an accumulator nothing depends on has a zero Jacobian
     # column, and Radau's finite-difference Jacobian then diverges.
     dynamic = [SPEED, ANGLE, ANGLE_RATE, OMEGA]
-    scales = [v_max, 0.1, 1.0, v_max / p[INDEX["wheel.unloaded_radius_m"]]]
+    scales = [v_max, 0.1, 1.0, v_max / p[INDEX[K.WHEEL_UNLOADED_RADIUS_M]]]
     if params.has("tire_relaxation"):
         dynamic, scales = [*dynamic, TYRE_FORCE], [*scales, load]
     if params.has("brake_fade"):
@@ -103,6 +104,6 @@ def _check_modelled(params: RigParameters) -> None:
             state = "on" if unsupported else "off"
             raise ParameterError(f"the reference solution does not model elements.{element} "
                                  f"{state}; compare without it")
-    if params.number("actuator.backlash_a") > 0.0:
+    if params.number(K.ACTUATOR_BACKLASH_A) > 0.0:
         raise ParameterError("the reference solution does not model the valve's "
                              "actuator.backlash_a; compare without it")

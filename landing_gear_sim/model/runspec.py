@@ -16,6 +16,7 @@ from types import ModuleType
 from typing import TYPE_CHECKING
 
 from landing_gear_sim.errors import ScenarioError
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import PA_PER_BAR
 
@@ -101,7 +102,7 @@ PROFILES: dict[str, tuple[Builder, bool, float]] = {
     "constant": (_constant, True, 0.0),
     "osc-low": (lambda s, p: _sc().oscillating(**_sc().OSC_LOW), True, 0.0),
     "osc-high": (lambda s, p: _sc().oscillating(**_sc().OSC_HIGH), True, 0.0),
-    "ramp": (lambda s, p: _sc().quasi_static_ramp(p.number("actuator.max_current_a")),
+    "ramp": (lambda s, p: _sc().quasi_static_ramp(p.number(K.ACTUATOR_MAX_CURRENT_A)),
              False, 20.0),
     "steps": (lambda s, p: _sc().steps(), False, 8.0),
     "sweep": (lambda s, p: _sc().sine_sweep(), False, 20.0),
@@ -135,8 +136,8 @@ def build_scenario(spec: RunSpec, params: RigParameters, recorded: Run | None = 
     if not contact:
         return sc.actuator_test(params, profile, duration or 10.0, spec.name, rate)
     if spec.profile == "file":  # a recorded run already holds its braking start
-        times = sc.sample_times(duration, rate or params.number("simulation.output_rate_hz"))
+        times = sc.sample_times(duration, rate or params.number(K.SIMULATION_OUTPUT_RATE_HZ))
         return sc.Scenario(spec.name, profile(times), 1.0 / (times[1] - times[0]), True,
-                           params.number("rig_test.initial_speed_m_s"),
-                           params.number("rig_test.stop_speed_m_s"), "replayed current")
+                           params.number(K.RIG_TEST_INITIAL_SPEED_M_S),
+                           params.number(K.RIG_TEST_STOP_SPEED_M_S), "replayed current")
     return sc.rig_test(params, profile, spec.name, rate)

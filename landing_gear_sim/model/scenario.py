@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from landing_gear_sim.errors import ScenarioError
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.run import Run
 from msg_tools.units import PA_PER_BAR
@@ -244,15 +245,15 @@ def from_run(run: Run) -> tuple[Profile, float]:
 
 def current_for_pressure(params: RigParameters, pressure_pa: float) -> float:
     """Valve current whose static-map pressure is ``pressure_pa`` (inverse of the map)."""
-    k1, k2 = params.number("actuator.map_k1_pa_per_a"), params.number("actuator.map_k2_pa_per_a2")
-    p_max = params.number("actuator.max_pressure_pa")
+    k1, k2 = params.number(K.ACTUATOR_MAP_K1_PA_PER_A), params.number(K.ACTUATOR_MAP_K2_PA_PER_A2)
+    p_max = params.number(K.ACTUATOR_MAX_PRESSURE_PA)
     if not 0.0 <= pressure_pa <= p_max:
         raise ScenarioError(f"pressure {pressure_pa / PA_PER_BAR:g} bar is outside the valve "
                             f"range 0..{p_max / PA_PER_BAR:g} bar")
-    target = pressure_pa / params.number("actuator.gain")
+    target = pressure_pa / params.number(K.ACTUATOR_GAIN)
     excess = target / k1 if k2 == 0 else (-k1 + math.sqrt(k1 * k1 + 4 * k2 * target)) / (2 * k2)
-    current = params.number("actuator.deadband_current_a") + excess
-    if current > params.number("actuator.max_current_a"):
+    current = params.number(K.ACTUATOR_DEADBAND_CURRENT_A) + excess
+    if current > params.number(K.ACTUATOR_MAX_CURRENT_A):
         raise ScenarioError(f"pressure {pressure_pa / PA_PER_BAR:g} bar needs more than the "
                             f"valve's {params.number('actuator.max_current_a'):g} A")
     return current
@@ -267,20 +268,20 @@ def rig_test(params: RigParameters, braking: Profile, name: str = "rig_test",
     The run ends when the flywheel falls below ``rig_test.stop_speed_m_s`` or after
     ``rig_test.max_duration_s``.
     """
-    rate = rate_hz or params.number("simulation.output_rate_hz")
-    t = sample_times(params.number("rig_test.max_duration_s"), rate)
-    since = t - params.number("rig_test.brake_start_s")
-    ramp_s = params.number("rig_test.brake_ramp_s")
+    rate = rate_hz or params.number(K.SIMULATION_OUTPUT_RATE_HZ)
+    t = sample_times(params.number(K.RIG_TEST_MAX_DURATION_S), rate)
+    since = t - params.number(K.RIG_TEST_BRAKE_START_S)
+    ramp_s = params.number(K.RIG_TEST_BRAKE_RAMP_S)
     ramp = np.clip(since / ramp_s, 0.0, 1.0) if ramp_s > 0 else (since >= 0).astype(float)
     current = np.where(since >= 0, braking(np.maximum(since, 0.0)) * ramp, 0.0)
-    return Scenario(name, current, rate, True, params.number("rig_test.initial_speed_m_s"),
-                    params.number("rig_test.stop_speed_m_s"), "rig test, braking profile")
+    return Scenario(name, current, rate, True, params.number(K.RIG_TEST_INITIAL_SPEED_M_S),
+                    params.number(K.RIG_TEST_STOP_SPEED_M_S), "rig test, braking profile")
 
 
 def actuator_test(params: RigParameters, profile: Profile, duration_s: float,
                   name: str = "actuator_test", rate_hz: float | None = None) -> Scenario:
     """Wheel off the flywheel: only the valve and brake pressure respond."""
-    rate = rate_hz or params.number("simulation.output_rate_hz")
+    rate = rate_hz or params.number(K.SIMULATION_OUTPUT_RATE_HZ)
     current = profile(sample_times(duration_s, rate))
     return Scenario(name, current, rate, False, 0.0, 0.0, "actuator-only test")
 

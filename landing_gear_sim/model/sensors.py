@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import Value
 
@@ -40,15 +41,15 @@ class SensorModel:
 
     @classmethod
     def of(cls, params: RigParameters) -> SensorModel:
-        offset = (params.number("sensors.pressure_offset_pa")
+        offset = (params.number(K.SENSORS_PRESSURE_OFFSET_PA)
                   if params.has("pressure_sensor_offset") else 0.0)
-        return cls(offset, params.number("sensors.pressure_noise_pa"),
-                   params.number("sensors.speed_noise_rad_s"),
-                   params.number("sensors.force_noise_n"),
-                   params.number("sensors.crosstalk_fx_per_fz"),
-                   params.number("sensors.wheel_speed_delay_s"),
+        return cls(offset, params.number(K.SENSORS_PRESSURE_NOISE_PA),
+                   params.number(K.SENSORS_SPEED_NOISE_RAD_S),
+                   params.number(K.SENSORS_FORCE_NOISE_N),
+                   params.number(K.SENSORS_CROSSTALK_FX_PER_FZ),
+                   params.number(K.SENSORS_WHEEL_SPEED_DELAY_S),
                    tuple(params.number(k) for k in RUNOUT_KEYS),
-                   params.number("sensors.pressure_delay_s"))
+                   params.number(K.SENSORS_PRESSURE_DELAY_S))
 
     @property
     def ripples(self) -> bool:
@@ -112,8 +113,8 @@ class SensorModel:
         return reading_pa - self.pressure_offset_pa
 
 
-RUNOUT_KEYS = ("sensors.wheel_runout_1", "sensors.wheel_runout_1_phase_rad",
-               "sensors.wheel_runout_2", "sensors.wheel_runout_2_phase_rad")
+RUNOUT_KEYS = (K.SENSORS_WHEEL_RUNOUT_1, K.SENSORS_WHEEL_RUNOUT_1_PHASE_RAD,
+               K.SENSORS_WHEEL_RUNOUT_2, K.SENSORS_WHEEL_RUNOUT_2_PHASE_RAD)
 
 
 def late(times_s: np.ndarray, values: np.ndarray, delay_s: float) -> np.ndarray:

@@ -26,6 +26,7 @@ from landing_gear_sim.diagnosis.families.base import (
     sparse_coefficients,
     term_candidate,
 )
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 
 FRACTION_BOUND = 0.1  # of the other channel at most
@@ -41,7 +42,7 @@ class ChannelTerm:
     values: Callable[[ClassifiedRun], np.ndarray]
 
 
-LIBRARY = (ChannelTerm("sensors.crosstalk_fx_per_fz", "F_z", lambda r: r.vertical_load_n),)
+LIBRARY = (ChannelTerm(K.SENSORS_CROSSTALK_FX_PER_FZ, "F_z", lambda r: r.vertical_load_n),)
 
 
 class ChannelCrosstalk(Family):
@@ -52,8 +53,8 @@ class ChannelCrosstalk(Family):
     relations = (Relation.FREE_ROLLING,)
     rank = 5
     hidden = (Hidden("channel_crosstalk", "channel_crosstalk", lambda rng, datasheet: {
-        "sensors.crosstalk_fx_per_fz": rng.choice([-1, 1]) * rng.uniform(0.008, 0.03)},
-        "sensors.crosstalk_fx_per_fz", "crosstalk_fx_per_fz", 0.1),)
+        K.SENSORS_CROSSTALK_FX_PER_FZ: rng.choice([-1, 1]) * rng.uniform(0.008, 0.03)},
+        K.SENSORS_CROSSTALK_FX_PER_FZ, "crosstalk_fx_per_fz", 0.1),)
 
     def propose(self, evidence: Evidence) -> list[Proposal]:
         """The kept channels, fitted with what a crosstalk distorts in the calibration (the
@@ -65,7 +66,7 @@ class ChannelCrosstalk(Family):
         terms = select_terms(evidence.runs, evidence.braking, evidence.model)
         if not terms:
             return []
-        free = ("brake.gain_n_m_per_pa", "flywheel.inertia_kg_m2", "drag.coeff_n_s2_per_m2",
+        free = (K.BRAKE_GAIN_N_M_PER_PA, K.FLYWHEEL_INERTIA_KG_M2, K.DRAG_COEFF_N_S2_PER_M2,
                 *FRICTION)
         return [Proposal(term_candidate(
             self, [t.key for t in terms], list(terms.values()),

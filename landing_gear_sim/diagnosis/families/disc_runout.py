@@ -25,6 +25,7 @@ from landing_gear_sim.diagnosis.families.base import (
     term_candidate,
 )
 from landing_gear_sim.diagnosis.families.encoder_ripple import waves
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import display
 
@@ -39,9 +40,9 @@ class DiscRunout(Family):
     relations = (Relation.BRAKE_ANGLE,)
     rank = 3
     hidden = (Hidden("disc_runout", "wheel_angle", lambda rng, datasheet: {
-        "brake.runout_1": rng.uniform(0.02, 0.08),
-        "brake.runout_1_phase_rad": rng.uniform(-np.pi, np.pi)},
-        "brake.runout_1", "brake_runout_1", 0.1),)
+        K.BRAKE_RUNOUT_1: rng.uniform(0.02, 0.08),
+        K.BRAKE_RUNOUT_1_PHASE_RAD: rng.uniform(-np.pi, np.pi)},
+        K.BRAKE_RUNOUT_1, "brake_runout_1", 0.1),)
 
     def propose(self, evidence: Evidence) -> list[Proposal]:
         """The kept orders, each run at its own phase, fitted alone on the braking runs'
@@ -56,7 +57,7 @@ class DiscRunout(Family):
             BRAKE_RUNS, WHEEL, names=[f"brake_{k.split('.')[1]}" for k in orders]))]
 
     def formula(self, candidate: Candidate, params: RigParameters) -> str:
-        gain = display(params.number("brake.gain_n_m_per_pa"), "N m/Pa")
+        gain = display(params.number(K.BRAKE_GAIN_N_M_PER_PA), "N m/Pa")
         return (f"T_b = {gain}·P·(1 + {waves(candidate, params, BRAKE_RUNOUT_KEYS)}), "
                 "θ: wheel angle, φ: each run's own")
 

@@ -25,6 +25,7 @@ from landing_gear_sim.diagnosis.families.base import (
     sparse_coefficients,
     term_candidate,
 )
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.sensors import RUNOUT_KEYS
 from msg_tools.units import display
@@ -47,7 +48,7 @@ class EncoderRipple(Family):
     keys = RUNOUT_KEYS[::2]
     relations = (Relation.WHEEL_ANGLE,)
     rank = 2
-    hidden = (Hidden("wheel_angle", "wheel_angle", _hide, "sensors.wheel_runout_1",
+    hidden = (Hidden("wheel_angle", "wheel_angle", _hide, K.SENSORS_WHEEL_RUNOUT_1,
                      "wheel_runout_1", 0.1),)
 
     def propose(self, evidence: Evidence) -> list[Proposal]:

@@ -27,6 +27,7 @@ from landing_gear_sim.diagnosis.families.base import (
     sparse_coefficients,
     term_candidate,
 )
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import PA_PER_BAR, display
 
@@ -48,9 +49,9 @@ class GainTerm:
 
 
 LIBRARY = (
-    GainTerm("sliding_speed", "brake.gain_slope_wheel_speed_s_per_rad", "ω", ("rad/s", 1.0),
+    GainTerm("sliding_speed", K.BRAKE_GAIN_SLOPE_WHEEL_SPEED_S_PER_RAD, "ω", ("rad/s", 1.0),
              1 / 200.0, lambda b: b.wheel),
-    GainTerm("pressure_level", "brake.gain_slope_pressure_per_pa", "P", ("bar", PA_PER_BAR),
+    GainTerm("pressure_level", K.BRAKE_GAIN_SLOPE_PRESSURE_PER_PA, "P", ("bar", PA_PER_BAR),
              1 / 60e5, lambda b: b.pressure),
 )
 
@@ -81,7 +82,7 @@ class GainLaw(Family):
             return []
         return [Proposal(term_candidate(
             self, [t.key for t in terms], list(terms.values()),
-            [(-t.bound, t.bound) for t in terms], ("brake.gain_n_m_per_pa", *FRICTION),
+            [(-t.bound, t.bound) for t in terms], (K.BRAKE_GAIN_N_M_PER_PA, *FRICTION),
             BRAKE_RUNS, WHEEL, reports="+".join(t.family for t in terms)))]
 
     def formula(self, candidate: Candidate, params: RigParameters) -> str:
@@ -91,7 +92,7 @@ class GainLaw(Family):
                 unit, per_si = t.display
                 value = params.number(t.key) * per_si
                 parts.append(f"{'+' if value >= 0 else '−'} {abs(value):.3g}·{t.symbol}[{unit}]")
-        gain = display(params.number("brake.gain_n_m_per_pa"), "N m/Pa")
+        gain = display(params.number(K.BRAKE_GAIN_N_M_PER_PA), "N m/Pa")
         return f"T_b = {gain}·P·(1 {' '.join(parts)})"
 
 
@@ -102,7 +103,7 @@ def select_terms(runs: Sequence[br.Braking], params: RigParameters) -> dict[Gain
     for b in runs:
         torque, _ = br.torque_balance(b, params)
         m = np.flatnonzero(br.steady_braking_samples(b))[::DECIMATE]
-        ratio.append(torque[m] / (params.number("brake.gain_n_m_per_pa") * b.pressure[m]))
+        ratio.append(torque[m] / (params.number(K.BRAKE_GAIN_N_M_PER_PA) * b.pressure[m]))
         columns.append(np.column_stack([t.values(b)[m] for t in LIBRARY]))
     y, x = np.concatenate(ratio), np.vstack(columns)
     if y.size < 4 * len(LIBRARY):

@@ -22,10 +22,11 @@ from landing_gear_sim.diagnosis.families.base import (
     Proposal,
     term_candidate,
 )
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import display
 
-KEY = "actuator.backlash_a"
+KEY = K.ACTUATOR_BACKLASH_A
 BOUNDS = (0.0, 0.2)  # A: a fifth of the valve's range
 
 
@@ -47,7 +48,7 @@ class InputHistory(Family):
         excess = [c.deviation for c in evidence.violated(Relation.VALVE_DIRECTION)]
         if not excess or max(excess) <= 0:
             return []
-        k1 = evidence.model.number("actuator.map_k1_pa_per_a")
+        k1 = evidence.model.number(K.ACTUATOR_MAP_K1_PA_PER_A)
         start = min(max(max(excess) / k1, 1e-3), BOUNDS[1])
         return [Proposal(term_candidate(self, self.keys, (start,), (BOUNDS,), STATIC_MAP,
                                         ACTUATOR_RUNS, PRESSURE, held_out=BRAKE_RUNS))]

@@ -19,11 +19,12 @@ from landing_gear_sim.diagnosis.families.base import (
 )
 from landing_gear_sim.diagnosis.load_relation import LOAD_UNIT_N
 from landing_gear_sim.diagnosis.relations import Relation
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import reference_load_n
 from msg_tools.units import display
 
-KEY = "friction.load_sensitivity_per_n"
+KEY = K.FRICTION_LOAD_SENSITIVITY_PER_N
 
 
 class Load(Family):
@@ -43,7 +44,7 @@ class Load(Family):
         broken = evidence.violated(Relation.FRICTION_IN_LOAD)
         if not broken:
             return []
-        bound = 0.5 / evidence.model.number("loading.static_load_n")  # μ halved at most
+        bound = 0.5 / evidence.model.number(K.LOADING_STATIC_LOAD_N)  # μ halved at most
         start = float(np.clip(-broken[0].deviation / LOAD_UNIT_N, -0.9 * bound, 0.9 * bound))
         return [Proposal(term_candidate(self, self.keys, (start,), ((-bound, bound),),
                                         FRICTION, BRAKE_RUNS, WHEEL))]

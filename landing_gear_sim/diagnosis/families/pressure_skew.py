@@ -28,10 +28,11 @@ from landing_gear_sim.diagnosis.families.base import (
     Proposal,
     term_candidate,
 )
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import display
 
-KEY = "sensors.pressure_delay_s"
+KEY = K.SENSORS_PRESSURE_DELAY_S
 BOUNDS = (0.0, 0.1)  # s
 
 
@@ -55,7 +56,7 @@ class PressureSkew(Family):
         if not late or late[0] <= 0:
             return []
         model = evidence.model
-        delay = ("actuator.delay_s",) if model.has("actuator_delay") else ()
+        delay = (K.ACTUATOR_DELAY_S,) if model.has("actuator_delay") else ()
         candidate = term_candidate(self, self.keys, (min(max(late[0], 1e-4), 0.09),),
                                    (BOUNDS,), (*ACTUATOR, *delay),
                                    (*ACTUATOR_RUNS, *BRAKE_RUNS), (*PRESSURE, *WHEEL))

@@ -16,10 +16,11 @@ from landing_gear_sim.diagnosis.families.base import (
     Proposal,
     term_candidate,
 )
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import display
 
-KEY = "brake.gain_drift_per_run"
+KEY = K.BRAKE_GAIN_DRIFT_PER_RUN
 BOUNDS = (-0.2, 0.2)  # per run: a fifth of k_b from one run to the next at most
 
 
@@ -42,11 +43,11 @@ class RunDrift(Family):
         runs = sum(r.braking for r in evidence.runs)
         start = broken[0].deviation / max(runs - 1, 1)
         return [Proposal(term_candidate(self, self.keys, (start,), (BOUNDS,),
-                                        ("brake.gain_n_m_per_pa", *FRICTION), BRAKE_RUNS,
+                                        (K.BRAKE_GAIN_N_M_PER_PA, *FRICTION), BRAKE_RUNS,
                                         WHEEL))]
 
     def formula(self, candidate: Candidate, params: RigParameters) -> str:
-        gain = display(params.number("brake.gain_n_m_per_pa"), "N m/Pa")
+        gain = display(params.number(K.BRAKE_GAIN_N_M_PER_PA), "N m/Pa")
         return (f"k_b,i = {gain}·(1 {display(params.number(KEY), '1', '+.2f')}·(i − ī)), "
                 "i: braking run in run order")
 

@@ -17,10 +17,11 @@ from landing_gear_sim.diagnosis.families.base import (
     term_candidate,
 )
 from landing_gear_sim.diagnosis.findings import Signature, SignatureKind
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import display
 
-KEY = "sensors.wheel_speed_delay_s"
+KEY = K.SENSORS_WHEEL_SPEED_DELAY_S
 BOUNDS = (0.0, 0.2)  # s
 
 

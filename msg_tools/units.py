@@ -61,3 +61,10 @@ def display(value_si: float, unit: str, spec: str = ".4g") -> str:
     (``spec``: the number's format); a unit without a display one is kept."""
     shown, factor = DISPLAY.get(unit, (unit, 1.0))
     return f"{value_si * factor:{spec}} {shown}"
+
+
+def signed(value_si: float, unit: str = "", spec: str = ".3g") -> str:
+    """``value_si`` as the next term of a law written out: '+ 4.7 ms', '− 0.034' (a true
+    minus sign and the magnitude as :func:`display` shows it; ``unit`` '' for a number)."""
+    magnitude = display(abs(value_si), unit, spec) if unit else format(abs(value_si), spec)
+    return f"{'−' if value_si < 0 else '+'} {magnitude}"

@@ -13,6 +13,9 @@ from landing_gear_sim.diagnosis.families.base import term_candidate
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.model.parameters import INDEX, SPECS
+from msg_tools.units import signed
+
+SPEC_BY_KEY = {spec.key: spec for spec in SPECS}
 
 FROZEN = ['configuration', 'elements.gear_walk', 'elements.load_dependent_radius',
     'elements.actuator_dynamics', 'elements.drag', 'elements.actuator_delay',
@@ -76,6 +79,16 @@ def test_a_family_writes_its_law_from_the_models_values(reference, case):
     assert law and law != family.formula(candidate, rig.replace(
         {slot: 2 * rig.number(slot)}, "doubled"))
     assert candidate.family == family.reports and candidate.cause == "discovered"
+    if SPEC_BY_KEY[slot].signed:  # a term of either sign is written with its own
+        flipped = family.formula(candidate, rig.replace({slot: -rig.number(slot)}, "flipped"))
+        assert abs(flipped.count("−") - law.count("−")) == 1, (law, flipped)
+
+
+def test_a_term_of_a_law_is_written_with_its_sign_and_display_unit():
+    assert signed(0.0047, "s") == "+ 4.7 ms"
+    assert signed(-0.034) == "− 0.034"
+    assert signed(-1.2e-5, "1/N", ".2f") == "− 1.20 %/kN"
+    assert signed(0.02, "1", ".2f") == "+ 2.00 %"
 
 
 def test_candidates_and_findings_take_keywords_only():

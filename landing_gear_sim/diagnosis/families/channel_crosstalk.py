@@ -28,6 +28,7 @@ from landing_gear_sim.diagnosis.families.base import (
 )
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
+from msg_tools.units import signed
 
 FRACTION_BOUND = 0.1  # of the other channel at most
 
@@ -76,7 +77,7 @@ class ChannelCrosstalk(Family):
     def formula(self, candidate: Candidate, params: RigParameters) -> str:
         kept = [t for t in LIBRARY if t.key in candidate.keys]
         return "F_x,read = F_x " + " ".join(
-            f"{'+' if v >= 0 else '−'} {abs(v):.4g}·{t.symbol}"
+            f"{signed(v, spec='.4g')}·{t.symbol}"
             for t, v in ((t, params.number(t.key)) for t in kept))
 
 

@@ -29,7 +29,7 @@ from landing_gear_sim.diagnosis.families.base import (
 )
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
-from msg_tools.units import PA_PER_BAR, display
+from msg_tools.units import PA_PER_BAR, display, signed
 
 MIN_RELATIVE_EFFECT = 0.02  # a term changing the gain by less over its range is dropped
 
@@ -91,7 +91,7 @@ class GainLaw(Family):
             if t.key in candidate.keys:
                 unit, per_si = t.display
                 value = params.number(t.key) * per_si
-                parts.append(f"{'+' if value >= 0 else '−'} {abs(value):.3g}·{t.symbol}[{unit}]")
+                parts.append(f"{signed(value)}·{t.symbol}[{unit}]")
         gain = display(params.number(K.BRAKE_GAIN_N_M_PER_PA), "N m/Pa")
         return f"T_b = {gain}·P·(1 {' '.join(parts)})"
 

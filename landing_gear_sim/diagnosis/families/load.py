@@ -22,7 +22,7 @@ from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import reference_load_n
-from msg_tools.units import display
+from msg_tools.units import display, signed
 
 KEY = K.FRICTION_LOAD_SENSITIVITY_PER_N
 
@@ -51,7 +51,7 @@ class Load(Family):
 
     def formula(self, candidate: Candidate, params: RigParameters) -> str:
         kappa = params.number(KEY)
-        return (f"μ = μ_B(λ)·(1 {'−' if kappa >= 0 else '+'} {display(abs(kappa), '1/N', '.3f')}·"
+        return (f"μ = μ_B(λ)·(1 {signed(-kappa, '1/N', '.3f')}·"
                 f"(F_z − {display(reference_load_n(params), 'N', '.1f')}))")
 
 

@@ -18,7 +18,7 @@ from landing_gear_sim.diagnosis.families.base import (
 )
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
-from msg_tools.units import display
+from msg_tools.units import display, signed
 
 KEY = K.BRAKE_GAIN_DRIFT_PER_RUN
 BOUNDS = (-0.2, 0.2)  # per run: a fifth of k_b from one run to the next at most
@@ -48,7 +48,7 @@ class RunDrift(Family):
 
     def formula(self, candidate: Candidate, params: RigParameters) -> str:
         gain = display(params.number(K.BRAKE_GAIN_N_M_PER_PA), "N m/Pa")
-        return (f"k_b,i = {gain}·(1 {display(params.number(KEY), '1', '+.2f')}·(i − ī)), "
+        return (f"k_b,i = {gain}·(1 {signed(params.number(KEY), '1', '.2f')}·(i − ī)), "
                 "i: braking run in run order")
 
 

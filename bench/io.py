@@ -4,8 +4,8 @@ A 5-minute 1 kHz run (synthetic signals of the contract's ranges, written by thi
 written as a contract CSV and as an mcap bag; each is read in a fresh process and the peak
 memory allocated while reading (tracemalloc) is reported. Target (issue
 13): reading the bag takes <= 1.5x the memory of reading the CSV, and bag -> CSV -> bag keeps
-time to 1 µs. Printed, not yet met (issue 30): ``convert`` (read, write the CSV) at most 1x
-the input's size.
+time to 1 µs. Printed too (issue 30): ``convert`` (read, write the CSV) at most 1x the
+input's size.
 
 Run: ``python bench/io.py [DURATION_S]`` (part of ``make bench``).
 """

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+from collections import Counter
 from dataclasses import replace
 
 import numpy as np
@@ -31,6 +32,23 @@ def run_from_table(table: Table, where: str, name: str, mapping: Mapping | None 
     mapping = mapping or DEFAULT_MAPPING
     fields: dict[str, np.ndarray] = {}
     notes = table.notes
+    channels = _channels(table, where, mapping)
+    uses = Counter(channel.column for channel in channels.values())
+    for contract, channel in channels.items():
+        raw = table.columns[channel.column]
+        clock = _clock_seconds(raw) if contract == "time_s" else None
+        if clock is not None:
+            notes += (f"{where}: time column {channel.column} read as a clock time of day "
+                      f"(HH:MM:SS), from {raw[0]}",)
+        fields[CSV_TO_FIELD[contract]] = clock if clock is not None else \
+            _to_si(channel, raw, where, table.owned and uses[channel.column] == 1)
+    check_plausible(fields, where)
+    return Run(name=name, source=where, notes=notes, **fields)
+
+
+def _channels(table: Table, where: str, mapping: Mapping) -> dict[str, Channel]:
+    """Each contract column's channel in ``table``, in the unit the file states."""
+    channels = {}
     for contract in CSV_COLUMNS:
         channel = _with_written_unit(_master_time(mapping[contract], contract, table),
                                      contract, table, where)
@@ -38,15 +56,8 @@ def run_from_table(table: Table, where: str, name: str, mapping: Mapping | None 
             found = ", ".join(table.columns) or "none"
             raise RunFormatError(f"{where}: missing column {channel.column} for {contract} "
                                  f"(found {found}); name it in a column-mapping file")
-        raw = table.columns[channel.column]
-        clock = _clock_seconds(raw) if contract == "time_s" else None
-        if clock is not None:
-            notes += (f"{where}: time column {channel.column} read as a clock time of day "
-                      f"(HH:MM:SS), from {raw[0]}",)
-        fields[CSV_TO_FIELD[contract]] = clock if clock is not None else \
-            _to_si(channel, raw, where)
-    check_plausible(fields, where)
-    return Run(name=name, source=where, notes=notes, **fields)
+        channels[contract] = channel
+    return channels
 
 
 def _master_time(channel: Channel, contract: str, table: Table) -> Channel:
@@ -75,7 +86,10 @@ def _with_written_unit(channel: Channel, contract: str, table: Table, where: str
     return channel.with_unit(unit, UNITS[quantity][unit])
 
 
-def _to_si(channel: Channel, raw: np.ndarray, where: str) -> np.ndarray:
+def _to_si(channel: Channel, raw: np.ndarray, where: str, in_place: bool = False
+           ) -> np.ndarray:
+    """``raw`` in SI (``in_place``: into ``raw`` itself when it is a float array, which no
+    one else then reads)."""
     if raw.dtype.kind in "USO":
         raw = np.char.replace(np.char.strip(raw.astype(str), '"'), ",", ".")
         try:
@@ -84,7 +98,7 @@ def _to_si(channel: Channel, raw: np.ndarray, where: str) -> np.ndarray:
             return _calendar_seconds(channel, raw, where)
     if raw.dtype.kind == "M":
         return _calendar_seconds(channel, raw, where)
-    values = channel.to_si(raw)
+    values = channel.to_si(raw, out=raw if in_place and raw.dtype == np.float64 else None)
     bad = np.flatnonzero(~np.isfinite(values))
     if bad.size:
         raise RunFormatError(f"{where}: column {channel.column} has NaN/inf at data row "

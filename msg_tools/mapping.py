@@ -54,10 +54,17 @@ class Channel:
     field: str = ""
     unit_declared: bool = False
 
-    def to_si(self, raw: np.ndarray, factor: float | None = None) -> np.ndarray:
-        """SI values of ``raw`` (``factor`` instead of the unit's, e.g. 1 for SI bags)."""
+    def to_si(self, raw: np.ndarray, factor: float | None = None,
+              out: np.ndarray | None = None) -> np.ndarray:
+        """SI values of ``raw`` (``factor`` instead of the unit's, e.g. 1 for SI bags;
+        ``out``: a float array to write them into, ``raw`` itself included), the same
+        operations in the same order either way (the same bits)."""
         factor = self.factor if factor is None else factor
-        return (np.asarray(raw, dtype=float) * self.scale + self.offset) * factor
+        if out is None:
+            return (np.asarray(raw, dtype=float) * self.scale + self.offset) * factor
+        np.multiply(raw, self.scale, out=out)
+        np.add(out, self.offset, out=out)
+        return np.multiply(out, factor, out=out)
 
     def with_unit(self, unit: str, factor: float) -> Channel:
         return replace(self, unit=unit, factor=factor)

@@ -4,7 +4,8 @@
 file's size at the peak (an hour at 1 kHz, 206 MB, took ~1 GB to read and 2.2 GB to
 ``convert``). A large file whose layout its first and last lines show (the preamble, header
 and units rows in the head, data to the end, a decimal point) is read here: the layout from
-those lines by the same functions, the numbers by numpy from the open file. Anything else
+those lines by the same functions, the numbers by numpy from the open file, a chunk of rows
+at a time into one array per column (the run is then made of them in place). Anything else
 (a decimal comma, thousands separators, a footer, a last line cut short, clock times, a
 compressed file, a value that does not read) goes the whole-text way, which handles it and
 words its errors: this is a shortcut with one answer, never a second reader.
@@ -13,6 +14,7 @@ words its errors: this is a shortcut with one answer, never a second reader.
 from __future__ import annotations
 
 import codecs
+import itertools
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -34,6 +36,7 @@ from .text_table import (
 LARGE_BYTES = 8_000_000
 """Files from this size on take the shortcut (below it the text is small anyway)."""
 END_BYTES = 65_536  # read from each end of the file to see its layout
+CHUNK_ROWS = 5_000  # rows parsed at a time: ~0.5 MB of text
 
 
 def read_table_file(path: Path, wanted: Sequence[str], where: str,
@@ -75,7 +78,7 @@ def _streamed(path: Path, wanted: Sequence[str], where: str) -> Table | None:
     values = _load(path, encoding, dialect, [header.column(w) for w in wanted], first)
     if values is None:
         return None
-    return Table(dict(zip(wanted, values, strict=True)), header.units)
+    return Table(dict(zip(wanted, values, strict=True)), header.units, owned=True)
 
 
 def _ends(path: Path) -> tuple[list[str], list[str], str] | None:
@@ -102,10 +105,27 @@ def _ends(path: Path) -> tuple[list[str], list[str], str] | None:
 
 def _load(path: Path, encoding: str, dialect: Dialect, columns: list[int], first: int
           ) -> list[np.ndarray] | None:
+    """The ``columns`` of the data from line ``first`` on, each an array of its own, filled
+    CHUNK_ROWS rows at a time: at the peak the columns and one chunk (numpy's loadtxt of the
+    whole file grows one array past its end size, and its columns were views of it that
+    kept it alive beside the run's SI copies: 1.4 times the file's size to convert)."""
+    values = [np.empty(_line_count(path) - first) for _ in columns]
+    done = 0
     try:
         with path.open(encoding=encoding, newline="") as file:
-            values = np.loadtxt(file, delimiter=delimiter(dialect), quotechar='"', ndmin=2,
-                                usecols=columns, skiprows=first)
+            lines = itertools.islice(file, first, None)
+            while chunk := list(itertools.islice(lines, CHUNK_ROWS)):
+                block = np.loadtxt(chunk, delimiter=delimiter(dialect), quotechar='"',
+                                   ndmin=2, usecols=columns)
+                for column, read in zip(values, block.T, strict=True):
+                    column[done:done + len(block)] = read
+                done += len(block)
     except (ValueError, UnicodeDecodeError):
         return None
-    return list(values.T)
+    return [column[:done] for column in values]
+
+
+def _line_count(path: Path) -> int:
+    """Lines of ``path`` (its ``\n``: the file ends with one), counted in binary blocks."""
+    with path.open("rb") as file:
+        return sum(block.count(b"\n") for block in iter(lambda: file.read(1 << 20), b""))

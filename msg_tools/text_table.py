@@ -47,6 +47,9 @@ class Table:
     columns: dict[str, np.ndarray]
     units: dict[str, str]
     notes: tuple[str, ...] = ()
+    owned: bool = False
+    """The columns are this table's alone (float arrays no one else holds): the run is made
+    of them in place, not beside them (a long file's peak memory)."""
 
 
 def read_text(path: Path) -> str:

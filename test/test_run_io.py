@@ -19,6 +19,7 @@ from msg_tools.csv_io import format_csv, read_csv, read_mapping, write_csv
 from msg_tools.errors import RunFormatError
 from msg_tools.io import read_campaign, read_run, resample
 from msg_tools.run import Run
+from msg_tools.units import RPM_RAD_S
 
 MAPPING = """
 time_s: {column: t_ms, unit: ms}
@@ -262,6 +263,27 @@ def test_resample_puts_a_run_on_a_uniform_base(run):
                        atol=0.05)
 
 
+def test_a_long_text_run_whose_column_two_channels_read_is_read_once_per_channel(
+        tmp_path, run, monkeypatch):
+    """The streamed reader makes the run of its columns in place (a long file's peak
+    memory): a column two channels read, each in its own unit, is converted for each."""
+    import msg_tools.text_stream
+
+    path = tmp_path / "shared.csv"
+    write_csv(run, path)
+    (tmp_path / "map.yaml").write_text(
+        "wheel_speed_rad_s: {column: flywheel_speed_rad_s, unit: rpm}\n")
+    reads = []
+    for threshold in (10**12, 1):  # whole, then streamed
+        monkeypatch.setattr(msg_tools.text_stream, "LARGE_BYTES", threshold)
+        reads.append(read_csv(path, mapping=read_mapping(tmp_path / "map.yaml")))
+    whole, streamed = reads
+    for field in ("wheel_speed_rad_s", "flywheel_speed_rad_s"):
+        np.testing.assert_array_equal(getattr(streamed, field), getattr(whole, field))
+    np.testing.assert_array_equal(streamed.wheel_speed_rad_s,
+                                  streamed.flywheel_speed_rad_s * RPM_RAD_S)
+
+
 def test_compare_cli_scores_a_simulation_against_itself(tmp_path, csv_file, capsys):
     assert main(["compare", str(csv_file), str(csv_file), "--plot",
                  str(tmp_path / "c.png")]) == 0
@@ -291,11 +313,12 @@ LAYOUTS = {
     "a footer": lambda text: text + "end of log\n",
     "an unreadable value deep down": lambda text: text[:len(text) * 2 // 3] + "x" + text[
         len(text) * 2 // 3 + 1:],
+    "blank lines among the data": lambda text: text.replace("\n", "\n\n", 40),
 }
 
 
 STREAMED = [LAYOUTS[k] for k in ("the contract", "a preamble, a units row and semicolons",
-                                  "Windows line ends and a BOM")]
+                                  "Windows line ends and a BOM", "blank lines among the data")]
 
 
 @pytest.mark.parametrize("layout", LAYOUTS.values(), ids=LAYOUTS.keys())
@@ -313,6 +336,7 @@ def test_a_long_text_run_read_from_the_open_file_is_the_run_read_whole(tmp_path,
     read_text = msg_tools.text_stream.read_text
     monkeypatch.setattr(msg_tools.text_stream, "read_text",
                         lambda p: whole_texts.append(p) or read_text(p))
+    monkeypatch.setattr(msg_tools.text_stream, "CHUNK_ROWS", 7)  # chunks end anywhere
     for threshold in (10**12, 1):
         monkeypatch.setattr(msg_tools.text_stream, "LARGE_BYTES", threshold)
         try:

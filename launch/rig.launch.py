@@ -16,6 +16,7 @@ from launch_ros.actions import Node
 
 from landing_gear_sim.errors import GraphError
 from landing_gear_sim.ros.graph import LAUNCH_ARGUMENTS, PACKAGE, describe, options_from_arguments
+from landing_gear_sim.ros.launcher import parameter_arguments
 
 
 def _nodes(context):
@@ -23,8 +24,8 @@ def _nodes(context):
     options, params_file = options_from_arguments(values)
     # the user's ROS_DOMAIN_ID and discovery settings reach the nodes untouched
     return [Node(package=PACKAGE, executable=node.name, name=node.name, output="screen",
-                 namespace=node.namespace, parameters=[str(params_file), node.parameters],
-                 remappings=list(node.remappings))
+                 namespace=node.namespace, parameters=[str(params_file)],
+                 ros_arguments=parameter_arguments(node), remappings=list(node.remappings))
             for node in describe(options)]
 
 

@@ -46,7 +46,7 @@ from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.calibration.logger import Logger
 from landing_gear_sim.campaigns.engine import Task, client, run_tasks
 from landing_gear_sim.diagnosis.catalogue import gear_walk_key_parameters
-from landing_gear_sim.diagnosis.diagnose import diagnose
+from landing_gear_sim.diagnosis.diagnose import Diagnosis, diagnose
 from landing_gear_sim.diagnosis.families import HIDDEN, Hidden
 from landing_gear_sim.diagnosis.scoring import HELD_OUT_THRESHOLD
 from landing_gear_sim.model.parameters import RigParameters, load_parameters
@@ -158,8 +158,7 @@ def run_case(cause: str | None, seed: int, datasheet: RigParameters, light: bool
         family = FAMILIES[cause].family or cause
         found = [f for f in result.findings if f.cause == "discovered" and f.family == family
                  and f.held_out is not None and f.held_out < HELD_OUT_THRESHOLD]
-        verdict = f"discovered {result.findings[0].family}" if result.findings and \
-            result.verdict == "discovered" else result.verdict
+        verdict = _verdict(result)
         if result.verdict != "discovered" or not found:
             return False, verdict, math.nan
         return _within(case, found[0].parameters.get(_key(case, rig), math.nan), rig, verdict)
@@ -167,6 +166,17 @@ def run_case(cause: str | None, seed: int, datasheet: RigParameters, light: bool
     if result.verdict != cause or not found:
         return False, result.verdict, math.nan
     return _within(case, found[0].parameters[_key(case, rig)], rig, result.verdict)
+
+
+def _verdict(result: Diagnosis) -> str:
+    """The verdict with what names it: a discovered term's family, the equation an
+    unexplained finding places it in."""
+    best = result.findings[0] if result.findings else None
+    if best is not None and result.verdict == "discovered":
+        return f"discovered {best.family}"
+    if best is not None and result.verdict == "unexplained" and best.equation:
+        return f"unexplained ({best.equation})"
+    return result.verdict
 
 
 def _key(case: Case, rig: RigParameters) -> str:

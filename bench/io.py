@@ -12,6 +12,7 @@ Run: ``python bench/io.py [DURATION_S]`` (part of ``make bench``).
 
 from __future__ import annotations
 
+import argparse
 import subprocess
 import sys
 import tempfile
@@ -62,7 +63,10 @@ def probe(path: Path, output: Path | None = None) -> tuple[float, float]:
 
 
 def main() -> int:
-    duration = float(sys.argv[1]) if len(sys.argv) > 1 else 300.0
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("duration_s", nargs="?", type=float, default=300.0,
+                        help="length of the run at 1 kHz [s] (default 300)")
+    duration = parser.parse_args().duration_s
     with tempfile.TemporaryDirectory() as folder:
         run = long_run(duration)
         csv_path, bag_path = Path(folder) / "long.csv", Path(folder) / "long_bag"

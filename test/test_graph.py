@@ -256,11 +256,21 @@ def test_launch_file_starts_exactly_the_described_nodes(monkeypatch, tmp_path):
     options, _ = options_from_arguments(context)
     described = describe(options)
     assert [m["executable"] for m in made] == [n.name for n in described]
-    sessions = {m["parameters"][1].pop("run_id") for m in made}
+    # the node's own parameters as -p arguments: a dict, launch_ros writes to a file it
+    # never removes; the params file is the only file
+    assert all(len(m["parameters"]) == 1 for m in made)
+    given = [_overrides(m["ros_arguments"]) for m in made]
+    sessions = {g.pop("run_id") for g in given}
     assert len(sessions) == 1  # one session, every node in it
-    assert [m["parameters"][1] for m in made] == [
-        {k: v for k, v in n.parameters.items() if k != "run_id"} for n in described]
+    assert given == [{k: format_value(v) for k, v in n.parameters.items() if k != "run_id"}
+                     for n in described]
     assert all("additional_env" not in m for m in made)  # the user's environment, untouched
+
+
+def _overrides(arguments: list[str]) -> dict[str, str]:
+    """``-p name:=VALUE`` arguments as name -> VALUE text."""
+    assert arguments[::2] == ["-p"] * (len(arguments) // 2)
+    return dict(argument.split(":=", 1) for argument in arguments[1::2])
 
 
 def _float64(value: float) -> bytes:

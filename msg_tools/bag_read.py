@@ -52,7 +52,7 @@ class _Series:
     """Stamps and values of one contract column as they stream in (the stamps shared by
     the columns of one topic)."""
 
-    time_s: array = field(default_factory=lambda: array("d"))
+    time_s: array  # its topic's, shared
     values: array = field(default_factory=lambda: array("d"))
     positions: bool = False
     stamped: bool = False  # header stamps, not log times

@@ -54,11 +54,13 @@ COUNTER_EXCESS = 1.5  # a residual beyond this times the counter's own holds oth
 @dataclass(frozen=True)
 class AngleRipple:
     """The wheel channel's ripple in one run's free rolling, per order of ORDERS: relative
-    amplitude e [1], phase φ at the run's first sample [rad], 1-σ of e [1]."""
+    amplitude e [1], phase φ at the run's first sample [rad], 1-σ of e [1]; and the rms of
+    what the fit left [1]."""
 
     amplitude: tuple[float, ...]
     phase_rad: tuple[float, ...]
     std: tuple[float, ...]
+    residual_rms: float
 
 
 def measured_angle_rad(run: ClassifiedRun) -> np.ndarray:
@@ -91,19 +93,30 @@ def ripple_regressors(centred_s: np.ndarray, angle_rad: np.ndarray) -> np.ndarra
     """A quadratic trend in time (``centred_s``: time about the window's middle), then
     cos(mθ), sin(mθ) per order of ORDERS, (n, TREND + 2·len(ORDERS))."""
     waves = [f(m * angle_rad) for m in ORDERS for f in (np.cos, np.sin)]
-    return np.column_stack([np.ones_like(centred_s), centred_s, centred_s ** 2, *waves])
+    return np.column_stack([_trend(centred_s), *waves])
+
+
+def _trend(centred_s: np.ndarray) -> np.ndarray:
+    """The quadratic trend's columns, (n, TREND)."""
+    return np.column_stack([np.ones_like(centred_s), centred_s, centred_s ** 2])
 
 
 def angle_ripple(run: ClassifiedRun) -> AngleRipple | None:
-    """The ripple of ``run``'s wheel channel per order (least squares), or None; through a
-    counting encoder with the σ its counter gives (:func:`counting_std`)."""
+    """The ripple of ``run``'s wheel channel per order (least squares), or None."""
     fitted = ripple_design(run)
     if fitted is None:
         return None
-    y, design = fitted
-    ripple = _fit(y, design)
-    left = float(np.std(y - design @ np.linalg.lstsq(design, y, rcond=None)[0]))
-    counted = counting_std(run, left)
+    return _fit(*fitted)
+
+
+def checked_ripple(run: ClassifiedRun) -> AngleRipple | None:
+    """:func:`angle_ripple` with the σ a consistency check holds it to: through a counting
+    encoder the σ its counter gives (:func:`counting_std`). Only the check needs it, not
+    the phase a simulation of the run takes (:func:`run_phases`, every simulation)."""
+    ripple = angle_ripple(run)
+    if ripple is None:
+        return None
+    counted = counting_std(run, ripple.residual_rms)
     return ripple if counted is None else dataclasses.replace(ripple, std=counted)
 
 
@@ -140,7 +153,7 @@ def _counted_without_ripple(t: np.ndarray, reading: np.ndarray, quantum_rad: flo
                             ) -> list[np.ndarray]:
     """The speed ``reading`` [rad/s] at times ``t`` smoothed (quadratic trend) and counted
     again through ``quantum_rad`` per count, once per drawn counter phase."""
-    trend = ripple_regressors(t - t.mean(), np.zeros_like(t))[:, :TREND]
+    trend = _trend(t - t.mean())
     smooth = trend @ np.linalg.lstsq(trend, reading, rcond=None)[0]
     counts = wheel_angle_rad(t, smooth) / quantum_rad
     phases = np.random.default_rng(COUNTER_SEED).uniform(size=COUNTER_PHASES)
@@ -160,12 +173,13 @@ def run_phases(params: RigParameters, run: ClassifiedRun) -> RigParameters:
 
 def _fit(y: np.ndarray, design: np.ndarray) -> AngleRipple:
     coef, *_ = np.linalg.lstsq(design, y, rcond=None)
-    std = linear_std(design, y - design @ coef, design.shape[1])
+    residual = y - design @ coef
+    std = linear_std(design, residual, design.shape[1])
     pairs = [(coef[TREND + 2 * i], coef[TREND + 2 * i + 1]) for i in range(len(ORDERS))]
     return AngleRipple(tuple(math.hypot(c, s) for c, s in pairs),
                        tuple(math.atan2(-s, c) for c, s in pairs),
                        tuple(float(max(std[TREND + 2 * i], std[TREND + 2 * i + 1]))
-                             for i in range(len(ORDERS))))
+                             for i in range(len(ORDERS))), float(np.std(residual)))
 
 
 def has_brake_runout(params: RigParameters) -> bool:

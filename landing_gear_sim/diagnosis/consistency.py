@@ -44,8 +44,8 @@ from landing_gear_sim.calibration.statistics import (
 from landing_gear_sim.calibration.wheel_angle import (
     BRAKE_RUNOUT_KEYS,
     ORDERS,
-    angle_ripple,
     brake_ripple,
+    checked_ripple,
 )
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.load_relation import (
@@ -232,7 +232,7 @@ def _current_rate(run: ClassifiedRun, noise: float) -> np.ndarray:
 def _wheel_angle(run: ClassifiedRun, params: RigParameters) -> Check | None:
     """The wheel channel's strongest ripple with the wheel's angle in free rolling, beyond
     the model's own run-out of that order [relative to ω]."""
-    ripple = angle_ripple(run)
+    ripple = checked_ripple(run)
     if ripple is None:
         return None
     runout = SensorModel.of(params).runout

@@ -22,7 +22,13 @@ from landing_gear_sim.calibration.statistics import (
 )
 from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model import keys as K
-from landing_gear_sim.model.elements import brake_torques, fade_factor, slip_ratio
+from landing_gear_sim.model.elements import (
+    brake_torques,
+    fade_factor,
+    flywheel_extra_force,
+    slip_ratio,
+    wheel_extra_torque,
+)
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s, rolling_radius_at
 from landing_gear_sim.model.sensors import SensorModel
@@ -131,7 +137,9 @@ def fit_flywheel(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
         if idx.size < 20:
             continue
         dt = np.diff(b.time_s, prepend=b.time_s[0])
-        blocks.append(np.column_stack([-np.cumsum(b.force * dt)[idx],
+        # the flywheel's generic slot is known, like F_x (0 unless a diagnosis found one)
+        force = b.force + flywheel_extra_force(p.vector(), b.speed_m_s)
+        blocks.append(np.column_stack([-np.cumsum(force * dt)[idx],
                                        -np.cumsum(b.speed_m_s ** 2 * dt)[idx]]))
         targets.append(b.speed_m_s[idx])
     if not blocks:
@@ -163,8 +171,10 @@ def _sample_weights(per_run: Sequence[np.ndarray]) -> np.ndarray:
 
 
 def torque_balance(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
-    """Brake torque r F_x − J_w ω̇ [N m] and the energy the brake absorbed, ∫ T_b ω dt [J]."""
-    torque = rolling_radius_at(p, b.load) * b.force - p.number(K.WHEEL_INERTIA_KG_M2) * b.wheel_rate
+    """Brake torque r F_x − J_w ω̇ − T_extra(ω) [N m] (T_extra: the wheel's generic slot of
+    ``p``, 0 unless a diagnosis found one) and the energy the brake absorbed, ∫ T_b ω dt [J]."""
+    torque = rolling_radius_at(p, b.load) * b.force - p.number(K.WHEEL_INERTIA_KG_M2) \
+        * b.wheel_rate - wheel_extra_torque(p.vector(), b.wheel)
     dt = np.diff(b.time_s, prepend=b.time_s[0])
     power = np.where(b.time_s > b.start_s - 0.1, np.clip(torque, 0, None), 0.0) \
         * np.clip(b.wheel, 0, None)

@@ -21,6 +21,7 @@ from landing_gear_sim.calibration.wheel_angle import (
     run_phases,
 )
 from landing_gear_sim.model import keys as K
+from landing_gear_sim.model.elements import load_lift
 from landing_gear_sim.model.integrate import SimulationResult, simulate
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import at_static_load, rim_speed_m_s
@@ -77,15 +78,14 @@ def run_parameters(params: RigParameters, campaign_order: float) -> RigParameter
 
 
 def run_static_load_n(run: ClassifiedRun, params: RigParameters) -> float | None:
-    """The static load the loading device held in ``run`` [N]: the mean of F_z + k_L v² in
+    """The static load the loading device held in ``run`` [N]: the mean of F_z + lift(v) in
     the free rolling before the brake acts (the load settled and the speed nearly steady, so
     the servo's lag is nil); None when the run has too little free rolling."""
     mask = free_rolling(run) if run.braking else np.zeros(len(run), dtype=bool)
     if mask.sum() < STATIC_LOAD_SAMPLES:
         return None
     speed = rim_speed_m_s(params, run.flywheel_speed_rad_s[mask])
-    lift = params.number(K.LOADING_LIFT_COEFF_N_S2_PER_M2)
-    return float(np.mean(run.vertical_load_n[mask] + lift * speed * speed))
+    return float(np.mean(run.vertical_load_n[mask] + load_lift(params.vector(), speed)))
 
 
 def _at_run_load(params: RigParameters, run: ClassifiedRun) -> RigParameters:

@@ -79,6 +79,11 @@ LIFT = INDEX[K.LOADING_LIFT_COEFF_N_S2_PER_M2]
 LOAD_TAU = INDEX[K.LOADING_SERVO_TIME_CONSTANT_S]
 TOUCHDOWN_RAMP = INDEX[K.LOADING_TOUCHDOWN_RAMP_S]
 TOUCHDOWN_T = INDEX[K.RIG_TEST_TOUCHDOWN_S]
+WHEEL_EXTRA_0 = INDEX[K.WHEEL_EXTRA_TORQUE_N_M]
+WHEEL_EXTRA_1 = INDEX[K.WHEEL_EXTRA_TORQUE_N_M_S_PER_RAD]
+FLY_EXTRA_0 = INDEX[K.FLYWHEEL_EXTRA_FORCE_N]
+FLY_EXTRA_1 = INDEX[K.FLYWHEEL_EXTRA_FORCE_N_S_PER_M]
+LOAD_EXTRA_1 = INDEX[K.LOADING_EXTRA_LOAD_N_S_PER_M]
 
 
 @njit(cache=True, inline="always")
@@ -209,9 +214,34 @@ def drag_force(p, speed_m_s):
 
 
 @njit(cache=True)
+def drag_forces(p, speed_m_s):
+    """:func:`drag_force` of each speed of an array (n,) [N]."""
+    out = np.empty(speed_m_s.shape[0])
+    for i in range(out.shape[0]):
+        out[i] = drag_force(p, speed_m_s[i])
+    return out
+
+
+@njit(cache=True)
+def flywheel_extra_force(p, speed_m_s):
+    """The flywheel equation's generic slot: F₀ sgn v + F₁ v, a force opposing the motion
+    beside the drag (0 on the reference rig; floats or arrays)."""
+    return p[FLY_EXTRA_0] * np.sign(speed_m_s) + p[FLY_EXTRA_1] * speed_m_s
+
+
+@njit(cache=True)
+def wheel_extra_torque(p, wheel_speed_rad_s):
+    """The wheel equation's generic slot: T₀ sgn ω + T₁ ω, a torque opposing the rotation
+    beside the brake's (0 on the reference rig; floats or arrays). A locked wheel (ω = 0)
+    feels none: the lock holds it."""
+    return p[WHEEL_EXTRA_0] * np.sign(wheel_speed_rad_s) + p[WHEEL_EXTRA_1] * wheel_speed_rad_s
+
+
+@njit(cache=True)
 def wheel_acceleration(p, wheel_speed_rad_s, radius_m, tyre_force_n, brake_torque_n_m):
-    """ω̇ from eq. (7), with lock: a stopped wheel stays stopped while the brake holds it."""
-    net = radius_m * tyre_force_n - brake_torque_n_m
+    """ω̇ from eq. (7) with the wheel's generic slot, and lock: a stopped wheel stays stopped
+    while the brake holds it."""
+    net = radius_m * tyre_force_n - brake_torque_n_m - wheel_extra_torque(p, wheel_speed_rad_s)
     if wheel_speed_rad_s <= 0.0 and net <= 0.0:
         return 0.0
     return net / p[WHEEL_INERTIA]
@@ -254,11 +284,19 @@ def valve_static_pressure(p, current_a):
 
 
 @njit(cache=True)
+def load_lift(p, speed_m_s):
+    """What the speed takes off the loading device's set point: k_L v² and the loading
+    equation's generic slot c v [N] (floats or arrays)."""
+    return p[LIFT] * speed_m_s * speed_m_s + p[LOAD_EXTRA_1] * speed_m_s
+
+
+@njit(cache=True)
 def vertical_load_reference(p, time_s, speed_m_s):
-    """Loading-device reference F_z0 − k_L v², ramped in over the touch-down ramp."""
+    """Loading-device reference F_z0 − :func:`load_lift`, ramped in over the touch-down
+    ramp."""
     elapsed = time_s - p[TOUCHDOWN_T]
     if elapsed < 0.0:
         return 0.0
     ramp = p[TOUCHDOWN_RAMP]
     scale = 1.0 if ramp <= 0.0 or elapsed >= ramp else elapsed / ramp
-    return scale * max(p[LOAD_STATIC] - p[LIFT] * speed_m_s * speed_m_s, 0.0)
+    return scale * max(p[LOAD_STATIC] - load_lift(p, speed_m_s), 0.0)

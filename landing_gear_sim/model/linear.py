@@ -81,7 +81,8 @@ def operating_point(params: RigParameters, speed_m_s: float, slip: float = 0.05)
     if params.has("gear_walk"):
         x[ANGLE] = params.number(K.GEAR_WALK_LENGTH_M) * force / params.number(
             K.GEAR_WALK_STIFFNESS_N_M_PER_RAD)
-    pressure = radius * force / params.number(K.BRAKE_GAIN_N_M_PER_PA)
+    pressure = (radius * force - el.wheel_extra_torque(p, x[OMEGA])) / params.number(
+        K.BRAKE_GAIN_N_M_PER_PA)
     return OperatingPoint(speed_m_s, slip, load, pressure, x)
 
 

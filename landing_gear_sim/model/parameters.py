@@ -53,6 +53,11 @@ def _f(key: str, unit: str, description: str, positive: bool = True) -> ParamSpe
     return ParamSpec(key, unit, description, positive=positive)
 
 
+def _slot(key: str, unit: str, description: str) -> ParamSpec:
+    """A term of an equation's generic slot (issue 29): either sign, 0 when a file lacks it."""
+    return ParamSpec(key, unit, f"{description} (0: none)", signed=True, default=0.0)
+
+
 def _ripple(prefix: str, law: str, cause: str, read_from: str) -> tuple[ParamSpec, ...]:
     """A ripple with the wheel's angle once and twice per revolution: per order its
     relative amplitude and its phase at the run's first sample."""
@@ -171,6 +176,16 @@ SPECS: tuple[ParamSpec, ...] = (
               "read (a logger channel out of step; 0: none)", default=0.0),
     *_ripple("brake.runout", "the brake torque is k_b P", "a disc's run-out, thickness "
              "variation", "its torque balance"),
+    _slot(K.WHEEL_EXTRA_TORQUE_N_M, "N m", "torque T0 opposing the wheel's rotation beside the "
+          "brake's (a bearing's friction, a released brake that drags)"),
+    _slot(K.WHEEL_EXTRA_TORQUE_N_M_S_PER_RAD, "N m s/rad", "torque T1 omega opposing the "
+          "wheel's rotation (a viscous bearing, a seal)"),
+    _slot(K.FLYWHEEL_EXTRA_FORCE_N, "N", "force F0 opposing the flywheel's motion at its rim "
+          "beside the drag (its bearings' friction)"),
+    _slot(K.FLYWHEEL_EXTRA_FORCE_N_S_PER_M, "N s/m", "force F1 v opposing the flywheel's "
+          "motion (eddy currents, a viscous bearing)"),
+    _slot(K.LOADING_EXTRA_LOAD_N_S_PER_M, "N s/m", "load c v the loading device loses with "
+          "the speed beside the lift law: F_z0 - k_L v^2 - c v"),
 )
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}

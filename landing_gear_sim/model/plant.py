@@ -18,7 +18,7 @@ locked while the brake torque exceeds the tyre torque.
 
 Plant state vector (``N_STATES``): speed v (flywheel rim or aircraft) [m/s],
 gear-walk angle θ [rad] and rate [rad/s], wheel speed ω [rad/s], and four energy
-accumulators [J] (brake, drag, tyre slip, gear-walk damping) for bookkeeping, the
+accumulators [J] (brake, drag with the bearings, tyre slip, gear-walk damping) for bookkeeping, the
 relaxed tyre force [N] (used by the ``tire_relaxation`` element only) and the wheel's angle
 since the run's start [rad] (a disc's run-out acts at it; a simulation of a measured run
 sets it to the measured angle at each exchange step).
@@ -71,7 +71,7 @@ def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     """Write dx/dt of the plant state into ``dx`` (eqs. 1-8; rig or aircraft form)."""
     radius, hub, slip, fx = tyre_state(p, x, vertical_load_n)
     tb = el.brake_torque(p, pressure_pa, x[E_BRAKE], x[OMEGA], x[WHEEL_ANGLE])
-    drag = el.drag_force(p, x[SPEED])
+    drag = el.drag_force(p, x[SPEED]) + el.flywheel_extra_force(p, x[SPEED])
     mass = el.translational_mass(p)
     if p[el.HAS_GEAR_WALK] == 0.0:
         accel, angle_accel = (-fx - drag) / mass, 0.0
@@ -90,7 +90,8 @@ def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     dx[ANGLE_RATE] = angle_accel
     dx[OMEGA] = el.wheel_acceleration(p, x[OMEGA], radius, fx, tb)
     dx[E_BRAKE] = tb * max(x[OMEGA], 0.0)
-    dx[E_DRAG] = drag * x[SPEED]
+    # the bearings' losses are drag's: they leave the flywheel and the wheel as heat
+    dx[E_DRAG] = drag * x[SPEED] + el.wheel_extra_torque(p, x[OMEGA]) * x[OMEGA]
     dx[E_SLIP] = fx * (hub - x[OMEGA] * radius)
     dx[E_DAMP] = p[el.GW_DAMPING] * x[ANGLE_RATE] ** 2 if p[el.HAS_GEAR_WALK] else 0.0
     steady = vertical_load_n * el.tyre_friction(p, slip, x[SPEED], vertical_load_n)

@@ -47,6 +47,7 @@ from landing_gear_sim.calibration.wheel_angle import (
     brake_ripple,
     checked_ripple,
 )
+from landing_gear_sim.diagnosis.equation_library import equation_checks
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.load_relation import (
     LOAD_SPREAD,
@@ -111,6 +112,7 @@ def check_campaign(runs: Sequence[ClassifiedRun], params: RigParameters) -> list
         checks.extend(_gain_trends(braking, params))
         checks.extend(_pressure_timing(braking, params))
         checks.extend(friction_in_load(braking, params))
+        checks.extend(equation_checks(braking, params))
     return checks
 
 

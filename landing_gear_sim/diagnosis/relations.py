@@ -30,6 +30,9 @@ class Relation(str, enum.Enum):
     WHEEL_ANGLE = "wheel channel smooth in the wheel's angle"
     PRESSURE_TIMING = "brake torque in step with the measured pressure"
     BRAKE_ANGLE = "brake torque smooth in the wheel's angle"
+    WHEEL_BALANCE = "wheel turned by the tyre and the brake alone"
+    FLYWHEEL_BALANCE = "flywheel slowed by F_x and the drag alone"
+    LOADING_LAW = "vertical load follows F_z0 − k_L v²"
 
     def __str__(self) -> str:
         return self.value
@@ -57,6 +60,9 @@ _WHERE = {
     "WHEEL_ANGLE": ("wheel channel", "wheel_speed_rad_s"),
     "PRESSURE_TIMING": ("pressure channel", "pressure_pa"),
     "BRAKE_ANGLE": ("wheel", "longitudinal_force_n"),
+    "WHEEL_BALANCE": ("wheel", "longitudinal_force_n"),
+    "FLYWHEEL_BALANCE": ("flywheel", "flywheel_speed_rad_s"),
+    "LOADING_LAW": ("loading device", "vertical_load_n"),
 }
 @dataclass(frozen=True)
 class Check:

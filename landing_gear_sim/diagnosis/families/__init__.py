@@ -8,7 +8,8 @@ and writes its law with the fitted values; it also says how to hide its effect i
 generated campaign, so that the tests and the benchmark parametrise over :data:`REGISTRY`.
 The diagnosis tries them in this order (:func:`~..discovered.discover`): the valve and the
 channels first, since what they misread distorts every other relation, then the wheel's
-equation. Adding a family: one module here, its slot in the model, its line below.
+equation; last the equations' generic slots (:mod:`.equation_terms`), for what no named
+family holds. Adding a family: one module here, its slot in the model, its line below.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from landing_gear_sim.diagnosis.families import (
     channel_crosstalk,
     disc_runout,
     encoder_ripple,
+    equation_terms,
     gain_law,
     input_history,
     load,
@@ -42,6 +44,9 @@ REGISTRY: tuple[Family, ...] = tuple(sorted((
     gain_law.FAMILY,
     run_drift.FAMILY,
     load.FAMILY,
+    equation_terms.WHEEL_FAMILY,
+    equation_terms.FLYWHEEL_FAMILY,
+    equation_terms.LOADING_FAMILY,
 ), key=lambda f: f.rank))
 """Every family, in the order the diagnosis tries them (by rank; one rank: in this order)."""
 

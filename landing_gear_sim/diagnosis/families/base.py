@@ -137,14 +137,3 @@ def term_candidate(family: Family, keys: Sequence[str], start: Sequence[float],
                      bounds=tuple(bounds), free=tuple(free), runs=runs, channels=channels,
                      held_out=held_out, contract=contract, family=reports or family.reports,
                      neutral=(0.0,) * len(keys) if off else ())
-
-
-def sparse_coefficients(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """y ≈ c₀ + x c by the LARS lasso with its penalty chosen by BIC, on standardised
-    columns: c in the units of x's columns (0 for a term left out), shape (k,)."""
-    # imported here: scikit-learn costs ~1 s to import and most diagnoses never get here
-    from sklearn.linear_model import LassoLarsIC
-
-    spread = x.std(axis=0)
-    fit = LassoLarsIC(criterion="bic").fit((x - x.mean(axis=0)) / spread, y)
-    return np.asarray(fit.coef_) / spread

@@ -3,7 +3,9 @@ measurement equation (issue 14).
 
 Called for by the relation "free rolling ⇒ F_x = J_w ω̇ / r": what the F_x channel reads
 where the true F_x is known — before braking (the wheel's inertia force) and off the ground
-(0) — is regressed on the channel library by a sparse solver (BIC).
+(0) — is regressed on the channel library by a sparse solver (BIC). A channel kept must
+show in the flywheel's momentum balance too (:func:`flywheel_reads`): a bearing's torque on
+the wheel breaks the free-rolling relation alike, and was once named a crosstalk.
 """
 
 from __future__ import annotations
@@ -17,15 +19,16 @@ from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
 from landing_gear_sim.diagnosis.consistency import FORCE_FLOOR_N, Relation, free_rolling_excess
+from landing_gear_sim.diagnosis.equation_library import flywheel_carries
 from landing_gear_sim.diagnosis.families.base import (
     DECIMATE,
     Evidence,
     Family,
     Hidden,
     Proposal,
-    sparse_coefficients,
     term_candidate,
 )
+from landing_gear_sim.diagnosis.sparse import sparse_coefficients
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import signed
@@ -64,7 +67,9 @@ class ChannelCrosstalk(Family):
         high)."""
         if not evidence.violated(Relation.FREE_ROLLING):
             return []
-        terms = select_terms(evidence.runs, evidence.braking, evidence.model)
+        terms = {term: fraction for term, fraction in select_terms(
+            evidence.runs, evidence.braking, evidence.model).items()
+            if flywheel_reads(evidence, term, fraction)}
         if not terms:
             return []
         free = (K.BRAKE_GAIN_N_M_PER_PA, K.FLYWHEEL_INERTIA_KG_M2, K.DRAG_COEFF_N_S2_PER_M2,
@@ -103,6 +108,16 @@ def select_terms(runs: Sequence[ClassifiedRun], braking: Sequence[br.Braking],
     return {term: float(c) for term, c, top in zip(LIBRARY, fractions,
                                                    np.max(np.abs(x), axis=0), strict=True)
             if abs(c) * top > FORCE_FLOOR_N}
+
+
+def flywheel_reads(evidence: Evidence, term: ChannelTerm, fraction: float) -> bool:
+    """Whether the flywheel's momentum balance reads the F_x channel carrying ``fraction`` of
+    ``term`` too (at least half of it, the same way). A channel's error is read wherever the
+    channel is; a torque on the wheel (a bearing's) also breaks the free-rolling relation,
+    but the flywheel feels what the channel reads and its balance holds."""
+    carried, _ = flywheel_carries(evidence.braking, evidence.model,
+                                  lambda b: term.values(b.run))
+    return carried * fraction > 0 and abs(carried) >= abs(fraction) / 2
 
 
 def _channels(run: ClassifiedRun, mask: np.ndarray) -> np.ndarray:

@@ -22,9 +22,9 @@ from landing_gear_sim.diagnosis.families.base import (
     Family,
     Hidden,
     Proposal,
-    sparse_coefficients,
     term_candidate,
 )
+from landing_gear_sim.diagnosis.sparse import sparse_coefficients
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.sensors import RUNOUT_KEYS

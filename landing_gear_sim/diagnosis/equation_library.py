@@ -1,0 +1,283 @@
+"""Each equation's library of terms, and its error regressed on it (issue 29).
+
+Every effect, catalogued or not, is a missing term in one of the rig's equations. For the
+wheel's torque balance, the flywheel's momentum balance and the loading device's law, the
+error is computed from the measured signals under the model (the other equations' terms
+measured) over every braking run's samples that carry it, thinned to the filter's bandwidth.
+It is regressed on the equation's library — the terms of its generic slot in the plant
+(``wheel.extra_*``, ``flywheel.extra_*``, ``loading.extra_*``), beside the terms whose
+coefficients the calibration owns (k_b P in the wheel's; the flywheel's mass and drag; the
+lift) — by a sparse solver (scikit-learn's LARS lasso, BIC). A term the lasso keeps is
+significant when an ordinary fit of the kept and owned terms finds it against the error's own
+noise (t over the error's effective count, above :data:`Z_VIOLATED`) and large enough to
+matter (:data:`MIN_EFFECT` of the equation's scale): the equation's relation
+(:class:`~.relations.Relation`) is then violated, and the equation's family
+(:mod:`~.families.equation_terms`) proposes the term.
+"""
+
+from __future__ import annotations
+
+import abc
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.diagnosis.equations import Equation
+from landing_gear_sim.diagnosis.relations import Z_VIOLATED, Check, Relation
+from landing_gear_sim.diagnosis.scoring import effective_count
+from landing_gear_sim.diagnosis.sparse import sparse_coefficients
+from landing_gear_sim.model import elements as el
+from landing_gear_sim.model import keys as K
+from landing_gear_sim.model.parameters import RigParameters
+from msg_tools.units import display
+
+MIN_EFFECT = 0.005  # a term's rms effect over the equation's scale: half a per cent
+EDGE_S = 0.5  # the zero-phase filter's ends are left out
+SETTLE_S = 0.5  # after the touch-down ramp, before the loading device's load is its law
+
+
+@dataclass(frozen=True)
+class Term:
+    """A term of an equation's generic slot: its key (the coefficient), how it is written
+    in the law (``symbol``, '' for a constant), the coefficient's SI unit and admissible
+    magnitude, and its variable as the term enters the equation's error (coefficient 1)."""
+
+    key: str
+    symbol: str
+    unit: str
+    bound: float
+    values: Callable[[br.Braking], np.ndarray]
+
+
+@dataclass(frozen=True)
+class Rows:
+    """One run's regression rows: the equation's error, its library's terms (m, k), the
+    terms the calibration owns (m, j), and the equation's scale [its unit]."""
+
+    error: np.ndarray
+    terms: np.ndarray
+    owned: np.ndarray
+    scale: float
+
+
+@dataclass(frozen=True)
+class Selected:
+    """A term the equation's error needs: its fitted value, its t and its rms effect."""
+
+    term: Term
+    value: float
+    t: float
+    effect: float
+
+
+class Library(abc.ABC):
+    """One equation's generic slot (see the module docstring): its ``terms``, the relation
+    that says whether its error needs them, the unit of its error."""
+
+    equation: Equation
+    relation: Relation
+    terms: tuple[Term, ...]
+    unit: str
+
+    @abc.abstractmethod
+    def rows(self, b: br.Braking, params: RigParameters,
+             terms: Sequence[Term] | None = None) -> Rows | None:
+        """The regression rows of one braking run on ``terms`` (default: the library's; None:
+        the run has no samples to give)."""
+
+    @abc.abstractmethod
+    def law(self, written: str, params: RigParameters) -> str:
+        """The equation with its slot's terms ``written`` out in it."""
+
+    def select(self, braking: Sequence[br.Braking], params: RigParameters) -> list[Selected]:
+        """The library's terms the equation's error needs under ``params``."""
+        rows = self._rows(braking, params)
+        return [s for s in _fit(self.terms, rows) if _significant(s, rows)] if rows else []
+
+    def check(self, braking: Sequence[br.Braking], params: RigParameters) -> Check | None:
+        """The equation's relation over the campaign: its strongest term (None: no run to
+        tell)."""
+        rows = self._rows(braking, params)
+        fitted = _fit(self.terms, rows) if rows else []
+        if not fitted:
+            return None
+        strongest = max(fitted, key=lambda s: s.t)
+        floor = MIN_EFFECT * _scale(rows)
+        return Check(self.relation, "campaign", f"braking runs, {strongest.term.key}",
+                     strongest.effect, strongest.effect / strongest.t, floor, self.unit)
+
+    def _rows(self, braking: Sequence[br.Braking], params: RigParameters) -> list[Rows]:
+        return [r for b in braking if (r := self.rows(b, params)) is not None]
+
+
+def _fit(terms: Sequence[Term], rows: Sequence[Rows]) -> list[Selected]:
+    """The terms the lasso keeps among ``terms`` and the owned ones (all of ``terms`` when it
+    keeps none: the relation is checked all the same), each with its ordinary fit beside the
+    owned terms."""
+    y = np.concatenate([r.error for r in rows])
+    x, owned = np.vstack([r.terms for r in rows]), np.vstack([r.owned for r in rows])
+    if y.size < 10 * (x.shape[1] + owned.shape[1]):
+        return []
+    lasso = sparse_coefficients(np.hstack([x, owned]), y, intercept=False)
+    kept = [int(i) for i in np.flatnonzero(lasso[:len(terms)])] or list(range(len(terms)))
+    coef, t = ordinary_fit(np.hstack([x[:, kept], owned]), y)
+    return [Selected(terms[column], float(coef[i]), float(t[i]),
+                     abs(float(coef[i])) * float(np.sqrt(np.mean(x[:, column] ** 2))))
+            for i, column in enumerate(kept)]
+
+
+def _significant(selected: Selected, rows: Sequence[Rows]) -> bool:
+    return selected.t > Z_VIOLATED and selected.effect > MIN_EFFECT * _scale(rows)
+
+
+def _scale(rows: Sequence[Rows]) -> float:
+    return float(np.mean([r.scale for r in rows]))
+
+
+def ordinary_fit(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """y ≈ x c by least squares: c and |c| over its standard error, the residual's
+    variance taken over its effective count (an equation's error is not white)."""
+    coef, *_ = np.linalg.lstsq(x, y, rcond=None)
+    residual = y - x @ coef
+    variance = float(residual @ residual) / effective_count(residual)
+    std = np.sqrt(np.diag(np.linalg.pinv(x.T @ x)) * variance)
+    return coef, np.abs(coef) / std
+
+
+def _thinned(mask: np.ndarray, rate_hz: float) -> np.ndarray:
+    """The indices of ``mask`` away from the filter's ends, one per half period of its
+    cut-off (the signals are low-passed there: closer samples carry no news)."""
+    index = np.flatnonzero(mask)
+    edge = round(EDGE_S * rate_hz)
+    index = index[(index > edge) & (index < mask.size - edge)]
+    return index[::max(1, round(rate_hz / (2 * br.FILTER_HZ)))]
+
+
+def _about_run_mean(error: np.ndarray, terms: np.ndarray, owned: np.ndarray, scale: float
+                    ) -> Rows:
+    """Rows about their run's mean (each run's own constant: a static load, a speed's
+    start)."""
+    return Rows(error - error.mean(), terms - terms.mean(axis=0), owned - owned.mean(axis=0),
+                scale)
+
+
+class WheelLibrary(Library):
+    """The wheel's torque balance J_w ω̇ = r F_x − T_b − T₀ sgn ω − T₁ ω: a bearing's
+    friction, a released brake that drags, a seal. Its error is measured where the brake
+    holds steadily and, with no brake at all, in the free rolling before it."""
+
+    equation = Equation.WHEEL
+    relation = Relation.WHEEL_BALANCE
+    unit = "N m"
+    terms = (
+        Term(K.WHEEL_EXTRA_TORQUE_N_M, "", "N m", 2000.0, lambda b: np.sign(b.wheel)),
+        Term(K.WHEEL_EXTRA_TORQUE_N_M_S_PER_RAD, "·ω", "N m s/rad", 20.0, lambda b: b.wheel),
+    )
+
+    def rows(self, b: br.Braking, params: RigParameters,
+             terms: Sequence[Term] | None = None) -> Rows | None:
+        index = _thinned(br.steady_braking_samples(b) | br.free_rolling(b), b.run.rate_hz)
+        if index.size < 20:
+            return None
+        torque, energy = br.torque_balance(b, params)
+        model = br.model_torque(b, params, energy, index)
+        return Rows(torque[index] - model,
+                    np.column_stack([t.values(b)[index] for t in terms or self.terms]),
+                    model[:, None], float(np.mean(np.abs(model))))
+
+    def law(self, written: str, params: RigParameters) -> str:
+        return f"J_w·ω̇ = r·F_x − T_b {written}"
+
+
+class FlywheelLibrary(Library):
+    """The flywheel's momentum balance m_f v̇ = −F_x − α_d v² − F₀ sgn v − F₁ v: its
+    bearings' friction, eddy currents. Its error is measured integrated over the run,
+    m_f v + ∫(F_x + α_d v²) dt about each run's mean, as the calibration measures the
+    balance (the differentiated one carries m_f times the speed's noise: 2.7 kN rms)."""
+
+    equation = Equation.FLYWHEEL
+    relation = Relation.FLYWHEEL_BALANCE
+    unit = "N s"
+    terms = (
+        Term(K.FLYWHEEL_EXTRA_FORCE_N, "", "N", 5000.0, lambda b: -np.sign(b.speed_m_s)),
+        Term(K.FLYWHEEL_EXTRA_FORCE_N_S_PER_M, "·v", "N s/m", 100.0, lambda b: -b.speed_m_s),
+    )
+
+    def rows(self, b: br.Braking, params: RigParameters,
+             terms: Sequence[Term] | None = None) -> Rows | None:
+        index = _thinned(b.speed_m_s > 1.0 + params.number(K.RIG_TEST_STOP_SPEED_M_S),
+                         b.run.rate_hz)
+        if index.size < 20:
+            return None
+        p = params.vector()
+        dt = np.diff(b.time_s, prepend=b.time_s[0])
+        speed = b.speed_m_s
+        resisting = b.force + el.drag_forces(p, speed) + el.flywheel_extra_force(p, speed)
+        impulse = np.cumsum(resisting * dt)
+        columns = [np.cumsum(t.values(b) * dt) for t in terms or self.terms]
+        owned = [speed, np.cumsum(speed * speed * dt)]
+        return _about_run_mean((el.translational_mass(p) * speed + impulse)[index],
+                               np.column_stack(columns)[index], np.column_stack(owned)[index],
+                               float(np.std(impulse[index])))
+
+    def law(self, written: str, params: RigParameters) -> str:
+        return f"m_f·v̇ = −F_x − α_d·v² {written}"
+
+
+class LoadingLibrary(Library):
+    """The loading device's set point F_z0 − k_L v² − c v: a load that sags with speed
+    beside the lift law. Its error is measured once the load has settled, about each run's
+    own static load."""
+
+    equation = Equation.LOADING
+    relation = Relation.LOADING_LAW
+    unit = "N"
+    terms = (Term(K.LOADING_EXTRA_LOAD_N_S_PER_M, "·v", "N s/m", 500.0,
+                  lambda b: -b.speed_m_s),)
+
+    def rows(self, b: br.Braking, params: RigParameters,
+             terms: Sequence[Term] | None = None) -> Rows | None:
+        loaded = b.load > br.LOADED_N
+        if not loaded.any():
+            return None
+        touchdown = b.time_s[np.argmax(loaded)]
+        settled = b.time_s > touchdown + params.number(K.LOADING_TOUCHDOWN_RAMP_S) + SETTLE_S
+        index = _thinned(settled & loaded, b.run.rate_hz)
+        if index.size < 20:
+            return None
+        speed = b.speed_m_s[index]
+        return _about_run_mean(b.load[index] + el.load_lift(params.vector(), speed),
+                               np.column_stack([t.values(b)[index] for t in terms or self.terms]),
+                               (speed * speed)[:, None], float(np.mean(b.load[index])))
+
+    def law(self, written: str, params: RigParameters) -> str:
+        lift = display(params.number(K.LOADING_LIFT_COEFF_N_S2_PER_M2), "N s^2/m^2", ".3g")
+        return f"F_z = F_z0 − {lift}·v² {written}"
+
+
+WHEEL = WheelLibrary()
+FLYWHEEL = FlywheelLibrary()
+LOADING = LoadingLibrary()
+LIBRARIES: tuple[Library, ...] = (WHEEL, FLYWHEEL, LOADING)
+
+
+def equation_checks(braking: Sequence[br.Braking], params: RigParameters) -> list[Check]:
+    """Each library's relation over the braking runs ``braking`` under ``params``."""
+    return [c for lib in LIBRARIES if (c := lib.check(braking, params)) is not None]
+
+
+def flywheel_carries(braking: Sequence[br.Braking], params: RigParameters,
+                     values: Callable[[br.Braking], np.ndarray]) -> tuple[float, float]:
+    """How much of ``values`` (a signal of a braking run) the measured F_x carries that the
+    flywheel does not feel: its coefficient in the flywheel's balance error, and its t
+    (0, 0: no run to tell). A channel's error shows wherever the channel is read; a torque
+    on the wheel (a bearing's) does not reach the flywheel's balance."""
+    carried = (Term("", "", "", 0.0, values),)
+    rows = [r for b in braking if (r := FLYWHEEL.rows(b, params, carried)) is not None]
+    if not rows:
+        return 0.0, 0.0
+    coef, t = ordinary_fit(np.vstack([np.hstack([r.terms, r.owned]) for r in rows]),
+                           np.concatenate([r.error for r in rows]))
+    return float(coef[0]), float(t[0])

@@ -1,0 +1,110 @@
+"""``wheel``, ``flywheel`` and ``loading device``: terms no named family holds, in the rig's
+own equations (issue 29).
+
+Each family is one equation's generic slot (:mod:`~..equation_library`): called for by the
+equation's relation (its error needs a term of its library), it proposes the terms the
+error's sparse regression keeps, started at their fit, fitted with the parameters the
+calibration owns in the equation, and scored like any candidate. The finding is
+``discovered`` with the equation as its family and the extended law written out, e.g.
+``J_w·ω̇ = r·F_x − T_b − 62 N m``. They come after every named family (:data:`RANK`): what
+is left when none of those is called for or accepted.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+
+from landing_gear_sim.diagnosis import equation_library as eq
+from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
+from landing_gear_sim.diagnosis.families.base import (
+    Evidence,
+    Family,
+    Hidden,
+    Proposal,
+    term_candidate,
+)
+from landing_gear_sim.model import keys as K
+from landing_gear_sim.model.parameters import RigParameters
+from msg_tools.units import signed
+
+RANK = 8  # after every named family
+
+
+class EquationTerms(Family):
+    """The generic slot of one equation's ``library``; ``free``: the parameters the
+    calibration owns in it, fitted again with a term; ``channels``: those compared."""
+
+    library: ClassVar[eq.Library]
+    free: ClassVar[tuple[str, ...]]
+    channels: ClassVar[tuple[str, ...]]
+    rank = RANK
+
+    def __init_subclass__(cls) -> None:
+        cls.reports = cls.equation = str(cls.library.equation)
+        cls.keys = tuple(t.key for t in cls.library.terms)
+        cls.relations = (cls.library.relation,)
+
+    def propose(self, evidence: Evidence) -> list[Proposal]:
+        """The kept terms, started at their fit, fitted with the parameters the calibration
+        owns in the equation on the braking runs."""
+        if not evidence.violated(self.library.relation):
+            return []
+        chosen = self.library.select(evidence.braking, evidence.model)
+        if not chosen:
+            return []
+        return [Proposal(term_candidate(
+            self, [s.term.key for s in chosen],
+            [float(np.clip(s.value, -0.9 * s.term.bound, 0.9 * s.term.bound)) for s in chosen],
+            [(-s.term.bound, s.term.bound) for s in chosen], self.free, BRAKE_RUNS,
+            self.channels))]
+
+    def formula(self, candidate: Candidate, params: RigParameters) -> str:
+        written = " ".join(f"{signed(-params.number(t.key), t.unit)}{t.symbol}"
+                           for t in self.library.terms if t.key in candidate.keys)
+        return self.library.law(written, params)
+
+
+class WheelTerms(EquationTerms):
+    name = "wheel_equation"
+    library = eq.WHEEL
+    free = (K.BRAKE_GAIN_N_M_PER_PA, *FRICTION)
+    channels = WHEEL
+    hidden = (
+        Hidden("wheel_bearing", str(eq.WHEEL.equation), lambda rng, datasheet: {
+            K.WHEEL_EXTRA_TORQUE_N_M: rng.uniform(40.0, 120.0)},
+            K.WHEEL_EXTRA_TORQUE_N_M, "extra_torque_n_m", 0.3),
+        Hidden("wheel_seal", str(eq.WHEEL.equation), lambda rng, datasheet: {
+            K.WHEEL_EXTRA_TORQUE_N_M_S_PER_RAD: rng.uniform(0.3, 0.8)},
+            K.WHEEL_EXTRA_TORQUE_N_M_S_PER_RAD, "extra_torque_n_m_s_per_rad", 0.3),
+    )
+
+
+class FlywheelTerms(EquationTerms):
+    name = "flywheel_equation"
+    library = eq.FLYWHEEL
+    free = (K.FLYWHEEL_INERTIA_KG_M2, K.DRAG_COEFF_N_S2_PER_M2)
+    channels = ("flywheel_speed_rad_s", "wheel_speed_rad_s")
+    hidden = (
+        Hidden("flywheel_bearing", str(eq.FLYWHEEL.equation), lambda rng, datasheet: {
+            K.FLYWHEEL_EXTRA_FORCE_N: rng.uniform(150.0, 400.0)},
+            K.FLYWHEEL_EXTRA_FORCE_N, "extra_force_n", 0.3),
+    )
+
+
+class LoadingTerms(EquationTerms):
+    name = "loading_equation"
+    library = eq.LOADING
+    free = (K.LOADING_LIFT_COEFF_N_S2_PER_M2,)
+    channels = ("vertical_load_n",)
+    hidden = (
+        Hidden("load_sag", str(eq.LOADING.equation), lambda rng, datasheet: {
+            K.LOADING_EXTRA_LOAD_N_S_PER_M: rng.uniform(20.0, 60.0)},
+            K.LOADING_EXTRA_LOAD_N_S_PER_M, "extra_load_n_s_per_m", 0.3),
+    )
+
+
+WHEEL_FAMILY = WheelTerms()
+FLYWHEEL_FAMILY = FlywheelTerms()
+LOADING_FAMILY = LoadingTerms()

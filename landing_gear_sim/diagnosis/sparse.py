@@ -1,0 +1,21 @@
+"""The sparse solver the diagnosis regresses on libraries of terms with (issues 14, 29)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def sparse_coefficients(x: np.ndarray, y: np.ndarray, intercept: bool = True) -> np.ndarray:
+    """y ≈ c₀ + x c by the LARS lasso with its penalty chosen by BIC, on standardised
+    columns: c in the units of x's columns (0 for a term left out), shape (k,). Without
+    ``intercept`` y ≈ x c, the columns scaled by their rms (a constant column is a term)."""
+    # imported here: scikit-learn costs ~1 s to import and most diagnoses never get here
+    from sklearn.linear_model import LassoLarsIC
+
+    if intercept:
+        spread = x.std(axis=0)
+        fit = LassoLarsIC(criterion="bic").fit((x - x.mean(axis=0)) / spread, y)
+    else:
+        spread = np.sqrt(np.mean(x * x, axis=0))
+        fit = LassoLarsIC(criterion="bic", fit_intercept=False).fit(x / spread, y)
+    return np.asarray(fit.coef_) / spread

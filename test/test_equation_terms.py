@@ -1,0 +1,139 @@
+"""The rig's equations' generic slots (issue 29): the plant carries them, the calibration
+reads around them, each equation's error finds its own term, and the diagnosis reports a
+term no named family holds as `discovered` in its equation, with its law and its value.
+
+The effects are drawn here, from ranges the code under test never sees."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
+from landing_gear_sim.calibration.identify import identify
+from landing_gear_sim.calibration.runs import classify_all
+from landing_gear_sim.diagnosis import equation_library as eq
+from landing_gear_sim.diagnosis.diagnose import diagnose
+from landing_gear_sim.diagnosis.families import HIDDEN, REGISTRY
+from landing_gear_sim.diagnosis.families.equation_terms import EquationTerms
+from landing_gear_sim.diagnosis.relations import Relation
+from landing_gear_sim.model import keys as K
+from landing_gear_sim.model import scenario as sc
+from landing_gear_sim.model.integrate import simulate
+from msg_tools.io import read_campaign
+
+RUNS = ("actuator_ramp", "brake_const_10bar", "brake_const_20bar", "brake_const_30bar",
+        "brake_osc_low", "brake_osc_high")
+EQUATION_CASES = sorted(h.name for f in REGISTRY if isinstance(f, EquationTerms)
+                        for h in f.hidden)
+
+
+def _campaign(reference, folder, seed: int, hidden: dict[str, float] | None = None):
+    """A generated campaign (the project's own rig generator) with ``hidden`` in its rig,
+    classified, and the model calibrated on it."""
+    rig = rig_like(reference, np.random.default_rng(seed))
+    if hidden:
+        rig = rig.replace(hidden, "hidden")
+    generate_campaign(folder, rig, seed, RUNS)
+    runs = classify_all(read_campaign(folder).runs)
+    return runs, identify(runs, reference, jackknife=False).params
+
+
+def test_bearing_losses_slow_the_rig_and_the_energy_books_them_as_drag(reference):
+    bearings = reference.replace({K.WHEEL_EXTRA_TORQUE_N_M: 80.0,
+                                  K.WHEEL_EXTRA_TORQUE_N_M_S_PER_RAD: 0.4,
+                                  K.FLYWHEEL_EXTRA_FORCE_N: 300.0,
+                                  K.FLYWHEEL_EXTRA_FORCE_N_S_PER_M: 4.0}, "bearings")
+    plain = simulate(reference, sc.constant_pressure_test(reference, 30e5))
+    slowed = simulate(bearings, sc.constant_pressure_test(bearings, 30e5))
+    mass = 3500.0
+    lost = 0.5 * mass * (slowed.speed_m_s[0] ** 2 - slowed.speed_m_s[-1] ** 2)
+    spent = (slowed.brake_energy_j[-1] + slowed.drag_energy_j[-1] + slowed.slip_energy_j[-1]
+             + slowed.damping_energy_j[-1] + 0.75 * (slowed.wheel_speed_rad_s[-1] ** 2
+                                                     - slowed.wheel_speed_rad_s[0] ** 2)
+             + 0.5 * 272.9 * slowed.gear_rate_rad_s[-1] ** 2
+             + 0.5 * 6.9e5 * slowed.gear_angle_rad[-1] ** 2)
+    assert abs(lost - spent) < 1e-4 * lost
+    assert slowed.time_s[-1] < plain.time_s[-1]
+    assert slowed.drag_energy_j[-1] > plain.drag_energy_j[-1] + 300.0 * 100.0
+
+
+def test_a_load_sag_in_speed_takes_load_off_where_the_rig_runs_fast(reference):
+    sag = reference.replace({K.LOADING_EXTRA_LOAD_N_S_PER_M: 50.0}, "sag")
+    plain = simulate(reference, sc.constant_pressure_test(reference, 30e5))
+    sagging = simulate(sag, sc.constant_pressure_test(sag, 30e5))
+    early = np.flatnonzero((plain.time_s > 1.0) & (plain.time_s < 1.5))
+    drop = plain.vertical_load_n[early] - sagging.vertical_load_n[early]
+    assert drop == pytest.approx(50.0 * plain.speed_m_s[early], rel=0.02)
+
+
+def test_a_known_bearing_torque_is_not_read_as_brake_gain(reference, tmp_path):
+    """The torque balance gives the brake's torque beside the model's bearing torque: with
+    the slot known, k_b comes out as the rig's; without it, it absorbs the torque."""
+    torque = float(np.random.default_rng(7).uniform(60.0, 120.0))
+    runs, calibrated = _campaign(reference, tmp_path, 301, {K.WHEEL_EXTRA_TORQUE_N_M: torque})
+    rig = rig_like(reference, np.random.default_rng(301))
+    braking = [br.prepare(r, calibrated) for r in runs if r.braking]
+    known = calibrated.replace({K.WHEEL_EXTRA_TORQUE_N_M: torque}, "known")
+    (with_slot,) = br.fit_brake_gain(braking, known)
+    (without,) = br.fit_brake_gain(braking, calibrated.replace(
+        {K.WHEEL_EXTRA_TORQUE_N_M: 0.0}, "unknown"))
+    truth = rig.number(K.BRAKE_GAIN_N_M_PER_PA)
+    assert with_slot.value == pytest.approx(truth, rel=0.005)
+    assert abs(without.value / truth - 1) > 2 * abs(with_slot.value / truth - 1)
+
+
+@pytest.mark.parametrize("case", EQUATION_CASES)
+def test_each_equation_finds_its_own_hidden_term_and_no_other(reference, tmp_path, case):
+    family, hidden = HIDDEN[case]
+    drawn = hidden.draw(np.random.default_rng(sum(map(ord, case))), reference)
+    runs, calibrated = _campaign(reference, tmp_path, 310, drawn)
+    braking = [br.prepare(r, calibrated) for r in runs if r.braking]
+    found = {library.equation: {s.term.key: s.value for s in library.select(braking, calibrated)}
+             for library in eq.LIBRARIES}
+    assert found.pop(family.library.equation) == pytest.approx(drawn, rel=0.1)
+    assert not any(found.values()), found
+
+
+def test_a_clean_campaign_violates_no_equation_and_says_so(reference, tmp_path):
+    from landing_gear_sim.diagnosis.consistency import check_campaign
+
+    runs, calibrated = _campaign(reference, tmp_path, 320)
+    checks = [c for c in check_campaign(runs, calibrated)
+              if c.relation in (Relation.WHEEL_BALANCE, Relation.FLYWHEEL_BALANCE,
+                                Relation.LOADING_LAW)]
+    assert len(checks) == 3
+    assert not [c.describe() for c in checks if c.violated]
+
+
+def test_the_flywheel_tells_a_load_cell_crosstalk_from_a_bearing_torque(reference, tmp_path):
+    """Both make the F_x channel read a force in free rolling; only the crosstalk is a force
+    the flywheel does not feel."""
+    fraction = float(np.random.default_rng(8).uniform(0.01, 0.03))
+    for hidden, carried in (({K.SENSORS_CROSSTALK_FX_PER_FZ: fraction}, fraction),
+                            ({K.WHEEL_EXTRA_TORQUE_N_M: 80.0}, 0.0)):
+        folder = tmp_path / str(carried)
+        runs, calibrated = _campaign(reference, folder, 330, hidden)
+        braking = [br.prepare(r, calibrated) for r in runs if r.braking]
+        found, _ = eq.flywheel_carries(braking, calibrated, lambda b: b.run.vertical_load_n)
+        assert found == pytest.approx(carried, abs=0.1 * fraction)
+
+
+def test_an_effect_no_family_names_is_discovered_in_its_equation(reference, tmp_path):
+    """Case and size drawn by the test among the equations' hidden effects: `discovered`
+    with the equation as its family, a held-out gain, no catalogue name, the law written
+    out and the value within the case's tolerance."""
+    rng = np.random.default_rng(340)
+    family, hidden = HIDDEN[str(rng.choice(EQUATION_CASES))]
+    rig = rig_like(reference, rng).replace(hidden.draw(rng, reference), "hidden")
+    generate_campaign(tmp_path, rig, 340, RUNS)
+    result = diagnose(read_campaign(tmp_path).runs, reference)
+    assert result.verdict == "discovered", [(f.cause, f.family, f.delta_bic, f.held_out)
+                                            for f in result.candidates]
+    finding = result.findings[0]
+    assert finding.family == hidden.family and finding.held_out < 0
+    assert not {f.cause for f in result.findings} - {"discovered", "unexplained"}
+    assert finding.term.startswith(family.library.law("", rig).split("=")[0])
+    truth = rig.number(hidden.slot)
+    assert finding.parameters[hidden.key] == pytest.approx(truth, rel=hidden.tolerance)

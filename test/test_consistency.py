@@ -251,9 +251,10 @@ def test_an_effect_outside_the_catalogue_drawn_at_random_is_discovered_by_its_fa
         reference, tmp_path):
     """Case and size drawn by the test from the registry's hidden effects (never passed to
     the code under test): the verdict is `discovered` with that family, a held-out gain and
-    no catalogue name, and the parameter within the family's tolerance. (Slow: its seed
-    draws a disc run-out on a campaign with light stops, 65 s; the quick suite has the
-    run-out in test_trust, and the benchmark draws every family.)"""
+    no catalogue name, and the parameter within the family's tolerance. (Slow: a campaign
+    with light stops; its seed draws a flywheel's bearing since the registry has the
+    equations' effects, a disc run-out before, 35-65 s; the quick suite has both, and the
+    benchmark draws every family.)"""
     rng = np.random.default_rng(180)
     family, hidden = HIDDEN[str(rng.choice(sorted(HIDDEN)))]
     rig = rig_like(reference, rng)

@@ -9,7 +9,7 @@ def sparse_coefficients(x: np.ndarray, y: np.ndarray, intercept: bool = True) ->
     """y ≈ c₀ + x c by the LARS lasso with its penalty chosen by BIC, on standardised
     columns: c in the units of x's columns (0 for a term left out), shape (k,). Without
     ``intercept`` y ≈ x c, the columns scaled by their rms (a constant column is a term)."""
-    # imported here: scikit-learn costs ~1 s to import and most diagnoses never get here
+    # imported here: scikit-learn costs ~1 s to import, which only a diagnosis needs to pay
     from sklearn.linear_model import LassoLarsIC
 
     if intercept:

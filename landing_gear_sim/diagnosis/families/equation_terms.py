@@ -30,6 +30,7 @@ from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import signed
 
 RANK = 8  # after every named family
+TOLERANCE = 0.3  # relative, of a hidden effect's value
 
 
 class EquationTerms(Family):
@@ -66,19 +67,20 @@ class EquationTerms(Family):
         return self.library.law(written, params)
 
 
+def _hidden(name: str, library: eq.Library, key: str, span: tuple[float, float]) -> Hidden:
+    """An effect in ``library``'s slot ``key``, drawn in ``span`` (its SI unit), found within
+    TOLERANCE."""
+    return Hidden(name, str(library.equation), lambda rng, datasheet: {key: rng.uniform(*span)},
+                  key, key.split(".")[1], TOLERANCE)
+
+
 class WheelTerms(EquationTerms):
     name = "wheel_equation"
     library = eq.WHEEL
     free = (K.BRAKE_GAIN_N_M_PER_PA, *FRICTION)
     channels = WHEEL
-    hidden = (
-        Hidden("wheel_bearing", str(eq.WHEEL.equation), lambda rng, datasheet: {
-            K.WHEEL_EXTRA_TORQUE_N_M: rng.uniform(40.0, 120.0)},
-            K.WHEEL_EXTRA_TORQUE_N_M, "extra_torque_n_m", 0.3),
-        Hidden("wheel_seal", str(eq.WHEEL.equation), lambda rng, datasheet: {
-            K.WHEEL_EXTRA_TORQUE_N_M_S_PER_RAD: rng.uniform(0.3, 0.8)},
-            K.WHEEL_EXTRA_TORQUE_N_M_S_PER_RAD, "extra_torque_n_m_s_per_rad", 0.3),
-    )
+    hidden = (_hidden("wheel_bearing", eq.WHEEL, K.WHEEL_EXTRA_TORQUE_N_M, (40.0, 120.0)),
+              _hidden("wheel_seal", eq.WHEEL, K.WHEEL_EXTRA_TORQUE_N_M_S_PER_RAD, (0.3, 0.8)))
 
 
 class FlywheelTerms(EquationTerms):
@@ -86,11 +88,8 @@ class FlywheelTerms(EquationTerms):
     library = eq.FLYWHEEL
     free = (K.FLYWHEEL_INERTIA_KG_M2, K.DRAG_COEFF_N_S2_PER_M2)
     channels = ("flywheel_speed_rad_s", "wheel_speed_rad_s")
-    hidden = (
-        Hidden("flywheel_bearing", str(eq.FLYWHEEL.equation), lambda rng, datasheet: {
-            K.FLYWHEEL_EXTRA_FORCE_N: rng.uniform(150.0, 400.0)},
-            K.FLYWHEEL_EXTRA_FORCE_N, "extra_force_n", 0.3),
-    )
+    hidden = (_hidden("flywheel_bearing", eq.FLYWHEEL, K.FLYWHEEL_EXTRA_FORCE_N,
+                      (150.0, 400.0)),)
 
 
 class LoadingTerms(EquationTerms):
@@ -98,11 +97,7 @@ class LoadingTerms(EquationTerms):
     library = eq.LOADING
     free = (K.LOADING_LIFT_COEFF_N_S2_PER_M2,)
     channels = ("vertical_load_n",)
-    hidden = (
-        Hidden("load_sag", str(eq.LOADING.equation), lambda rng, datasheet: {
-            K.LOADING_EXTRA_LOAD_N_S_PER_M: rng.uniform(20.0, 60.0)},
-            K.LOADING_EXTRA_LOAD_N_S_PER_M, "extra_load_n_s_per_m", 0.3),
-    )
+    hidden = (_hidden("load_sag", eq.LOADING, K.LOADING_EXTRA_LOAD_N_S_PER_M, (20.0, 60.0)),)
 
 
 WHEEL_FAMILY = WheelTerms()

@@ -78,15 +78,21 @@ class SegmentedBagWriter:
         if self._writer is not None:
             self._close_segment()
 
-    def close(self) -> None:
-        """Close the open segment and join the segments; the bag is complete. Safe to call
-        twice."""
+    @property
+    def segment_count(self) -> int:
+        """Closed segments (storage files) the bag lists now."""
+        return len(self._closed)
+
+    def close(self, join: bool = True) -> None:
+        """Close the open segment and join the segments (unless this writer or ``join``
+        says not to: the segments stay, a complete bag all the same); the bag is complete.
+        Safe to call twice."""
         if self._writer is not None:
             self._close_segment()
         if not self._closed:
             self._open()  # an empty run still leaves a readable bag
             self._close_segment(keep_empty=True)
-        if self._join and self._closed[0]["relative_file_paths"][0].startswith(
+        if join and self._join and self._closed[0]["relative_file_paths"][0].startswith(
                 f"{self.path.name}_"):  # not joined yet (one segment too: one name always)
             self._join_segments()
 

@@ -250,8 +250,12 @@ def test_ros2_tools_on_a_running_rig_a_second_rig_beside_it_and_ctrl_c(workspace
     assert launch.returncode in (0, 130), output[-3000:]
     assert "Traceback" not in output and "process has died" not in output, output[-3000:]
     assert subprocess.run(["pgrep", "-s", str(launch.pid)]).returncode == 1  # no orphan
-    assert "bag closed" in output and sorted(p.name for p in bag.iterdir()) == [
-        "bag.mcap", "metadata.yaml"]
+    assert "bag closed" in output
+    files = sorted(p.name for p in bag.iterdir())
+    if "segments kept, not joined" in output:  # a long run: joining outlasts a stop
+        assert files[-1] == "metadata.yaml" and all(f.startswith("bag_") for f in files[:-1])
+    else:
+        assert files == ["bag.mcap", "metadata.yaml"]
 
 
 @needs_ros2

@@ -308,10 +308,14 @@ def test_a_segmented_bag_closes_as_one_file_named_after_the_bag(tmp_path, storag
         assert b"bag.mcap" in data and b".open_segment" not in data and b".joining" not in data
 
 
-def test_segments_are_kept_when_asked(tmp_path):
-    _segmented(tmp_path / "bag", join=False).close()
+@pytest.mark.parametrize("when", ["writer", "close"])
+def test_segments_are_kept_when_asked(tmp_path, when):
+    """By the writer (``join_segments:=false``) or at one close (a stop that cannot wait
+    for the join): the bag is complete all the same."""
+    writer = _segmented(tmp_path / "bag", join=when != "writer")
+    writer.close(join=when != "close")
     assert _values(tmp_path / "bag") == list(range(30))
-    assert len(list((tmp_path / "bag").glob("bag_*"))) == 3
+    assert len(list((tmp_path / "bag").glob("bag_*"))) == writer.segment_count == 3
     assert not (tmp_path / "bag" / OPEN_SEGMENT).exists()
 
 

@@ -498,3 +498,14 @@ def test_a_command_topic_remapped_on_its_source_and_the_actuator_is_found(tmp_pa
     assert processes["plant"].returncode == 0, plant_errors[-2000:]
     assert "run ends after 1500 samples" in plant_errors
     assert all(p.returncode == 0 for p in processes.values())
+
+
+def test_a_stop_by_a_signal_joins_the_bag_only_while_that_is_quick():
+    """A 300 s run's join (1.5 M messages) outlasted launch's SIGKILL on a busy machine, and
+    launch called the stopped run failed: a long bag stopped by a signal keeps its
+    segments; one that ends on its own is always joined."""
+    from landing_gear_sim.ros.nodes.recorder import JOIN_ON_STOP_MESSAGES, joins_on_close
+
+    assert joins_on_close(stopped=False, messages=1_500_000)
+    assert joins_on_close(stopped=True, messages=JOIN_ON_STOP_MESSAGES)
+    assert not joins_on_close(stopped=True, messages=JOIN_ON_STOP_MESSAGES + 1)

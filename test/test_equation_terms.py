@@ -137,3 +137,35 @@ def test_an_effect_no_family_names_is_discovered_in_its_equation(reference, tmp_
     assert finding.term.startswith(family.library.law("", rig).split("=")[0])
     truth = rig.number(hidden.slot)
     assert finding.parameters[hidden.key] == pytest.approx(truth, rel=hidden.tolerance)
+
+
+def test_of_two_causes_beside_a_discovered_term_only_the_one_it_replaces_goes(reference,
+                                                                               monkeypatch):
+    """Each cause is scored again from the extended model without it (here: told by a stand-
+    in); the one that no longer earns its place goes, its element off in the final model,
+    and the other stays."""
+    from landing_gear_sim.diagnosis.catalogue import CATALOGUE, CandidateFit
+    from landing_gear_sim.diagnosis.discovered import Story
+    from landing_gear_sim.diagnosis.findings import Finding
+    from landing_gear_sim.diagnosis.scoring import Scored
+
+    def scored(cause: str, params) -> Scored:
+        finding = Finding(cause=cause, parameters={}, std={}, evidence="", fit_before={},
+                          fit_after={}, delta_bic=-50.0, held_out=-50.0, accepted=True,
+                          term=f"law of {cause}")
+        return Scored(finding, CandidateFit(CATALOGUE.get(cause) or CATALOGUE["drag"], params,
+                                            {}, {}, np.ones(3)))
+
+    extended = reference.replace({"elements.tire_relaxation": True,
+                                  "tyre.relaxation_length_m": 0.1,
+                                  "elements.actuator_delay": True,
+                                  "actuator.delay_s": 0.005}, "both causes")
+    causes = [scored("tire_relaxation", extended), scored("actuator_delay", extended)]
+    said: list[str] = []
+    story = Story([], reference, reference, {}, [], [], said.append)
+    monkeypatch.setattr(Story, "_earns", lambda self, cause, model: cause is causes[1])
+    extension = story._beside([], causes, scored("discovered", extended), None)
+    assert extension.kept == [causes[1]] and said == [
+        "tire_relaxation not needed beside law of discovered"]
+    final = extension.scored.fit.params
+    assert not final.has("tire_relaxation") and final.has("actuator_delay")

@@ -151,15 +151,16 @@ class Story:
         off. A tyre's relaxation once fitted what a loading device's law, wrong in speed,
         left in the wheel channels (held out −2072 from the calibrated model); beside the
         law it is not needed. When no cause is left, the term fitted alone (``rival``)."""
-        kept = [s for s in accepted if self._earns(s, beside.fit.params)]
-        if len(kept) == len(accepted):
+        earns = [self._earns(s, beside.fit.params) for s in accepted]
+        if all(earns):
             return Extension(tried, accepted, beside)
-        dropped = [s.finding.cause for s in accepted if s not in kept]
-        self.say(f"{', '.join(dropped)} not needed beside {beside.finding.term}")
+        kept = [s for s, e in zip(accepted, earns, strict=True) if e]
+        dropped = [s for s, e in zip(accepted, earns, strict=True) if not e]
+        self.say(f"{_causes(dropped)} not needed beside {beside.finding.term}")
         if not kept and rival is not None and rival.finding.accepted:
             return Extension(tried, [], rival)
         params = beside.fit.params.replace(
-            {f"elements.{s.fit.candidate.element}": False for s in accepted if s not in kept},
+            {f"elements.{s.fit.candidate.element}": False for s in dropped},
             "causes not needed beside the discovered term")
         return Extension(tried, kept, Scored(beside.finding, replace(beside.fit, params=params)))
 

@@ -79,6 +79,11 @@ class SegmentedBagWriter:
             self._close_segment()
 
     @property
+    def joins(self) -> bool:
+        """Whether :meth:`close` joins the segments (unless that close says not to)."""
+        return self._join
+
+    @property
     def segment_count(self) -> int:
         """Closed segments (storage files) the bag lists now."""
         return len(self._closed)

@@ -10,10 +10,10 @@ The bag is written in segments (see :mod:`msg_tools.bag_segments`) of at least
 ``segment_s`` of sim time and ``segment_samples`` samples — a rule on the data, so the
 files are the same on every run — and joined into one file when it closes
 (``join_segments``; on a stop by a signal only a bag of up to JOIN_ON_STOP_MESSAGES
-messages, a longer one keeps its segments). SIGINT/SIGTERM close the bag complete; after SIGKILL it
-still opens and lacks only the open segment: about half a second of wall time at the
-graph's real-time factors (closing a segment costs ~30 ms, so at a high real-time factor
-the sample floor keeps the recorder from spending its time closing segments).
+messages, a longer one keeps its segments). SIGINT/SIGTERM close the bag complete; after
+SIGKILL it still opens and lacks only the open segment: about half a second of wall time
+at the graph's real-time factors (closing a segment costs ~30 ms, so at a high real-time
+factor the sample floor keeps the recorder from spending its time closing segments).
 """
 
 from __future__ import annotations
@@ -71,7 +71,6 @@ class RecorderNode(GraphNode):
         check_overrides(self)  # a typo must not leave an empty bag behind
         # the bag holds the names the rig published under (``/rig2/...`` for a second rig)
         self._names = {topic: self.resolve_topic_name(relative(topic)) for topic in TOPIC_TYPES}
-        self._join = join
         self._writer = SegmentedBagWriter(
             Path(path), {self._names[topic]: kind for topic, kind in TOPIC_TYPES.items()},
             storage, join)
@@ -155,7 +154,7 @@ class RecorderNode(GraphNode):
         self._flush(force=True)
         join = joins_on_close(stop_requested(), self._writer.message_count)
         self._writer.close(join=join)
-        kept = "" if join or not self._join else (
+        kept = "" if join or not self._writer.joins else (
             f"; stopped by a signal: its {self._writer.segment_count} segments kept, not "
             "joined (joining that many messages takes longer than a stop may)")
         say(self, f"bag closed: {self._writer.path} ({self._written} samples, "

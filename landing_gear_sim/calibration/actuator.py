@@ -41,15 +41,20 @@ class FrfEstimate:
 
 
 def fit_static_map(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
-    """Dead-band, k1, k2, saturation from quasi-static ramps (paper Fig. 8)."""
+    """Dead-band, k1, k2, saturation from quasi-static ramps (paper Fig. 8), beside the
+    map's generic slot k3 of ``p`` (read around, as the other calibrations read around
+    theirs)."""
     current = np.concatenate([r.current_a for r in runs])
     pressure = SensorModel.of(p).true_pressure(np.concatenate([r.pressure_pa for r in runs]))
-    max_current = p.number(K.ACTUATOR_MAX_CURRENT_A)
+    max_current, k3 = (p.number(k) for k in (K.ACTUATOR_MAX_CURRENT_A,
+                                             K.ACTUATOR_EXTRA_MAP_PA_PER_A3))
     scale = np.array([p.number(k) or 1.0 for k in STATIC_MAP])
     scale[0] = max(scale[0], 0.05)
 
     def residual(theta: np.ndarray) -> np.ndarray:
-        return (el.valve_map(current, max_current, *(theta * scale)) - pressure) / PA_PER_BAR
+        deadband, k1, k2, max_pressure = theta * scale
+        return (el.valve_map(current, max_current, deadband, k1, k2, k3, max_pressure)
+                - pressure) / PA_PER_BAR
 
     start = np.array([p.number(k) for k in STATIC_MAP]) / scale
     fit = least_squares(residual, start, x_scale="jac")

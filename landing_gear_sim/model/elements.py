@@ -84,6 +84,7 @@ WHEEL_EXTRA_1 = INDEX[K.WHEEL_EXTRA_TORQUE_N_M_S_PER_RAD]
 FLY_EXTRA_0 = INDEX[K.FLYWHEEL_EXTRA_FORCE_N]
 FLY_EXTRA_1 = INDEX[K.FLYWHEEL_EXTRA_FORCE_N_S_PER_M]
 LOAD_EXTRA_1 = INDEX[K.LOADING_EXTRA_LOAD_N_S_PER_M]
+MAP_EXTRA_3 = INDEX[K.ACTUATOR_EXTRA_MAP_PA_PER_A3]
 
 
 @njit(cache=True, inline="always")
@@ -268,19 +269,23 @@ def translational_mass(p):
 
 
 @njit(cache=True, inline="always")
-def valve_map(current_a, max_current_a, deadband_a, k1_pa_per_a, k2_pa_per_a2, max_pressure_pa):
-    """Static current→pressure map P = k1 (I−I0) + k2 (I−I0)², I within [0, I_max],
-    dead-band I0, saturation P_max [Pa]."""
+def valve_map(current_a, max_current_a, deadband_a, k1_pa_per_a, k2_pa_per_a2, k3_pa_per_a3,
+              max_pressure_pa):
+    """Static current→pressure map P = k1 e + k2 e² + k3 e³, e = I − I0 ≥ 0, I within
+    [0, I_max], dead-band I0, saturation P_max [Pa]; k3 is the valve equation's generic
+    slot (0 on the reference rig)."""
     current = np.minimum(np.maximum(current_a, 0.0), max_current_a)
     excess = np.maximum(current - deadband_a, 0.0)
-    return np.minimum(k1_pa_per_a * excess + k2_pa_per_a2 * excess * excess, max_pressure_pa)
+    pressure = (k1_pa_per_a * excess + k2_pa_per_a2 * excess * excess
+                + k3_pa_per_a3 * excess * excess * excess)
+    return np.minimum(np.maximum(pressure, 0.0), max_pressure_pa)
 
 
 @njit(cache=True)
 def valve_static_pressure(p, current_a):
     """The valve's static-map pressure [Pa] of the parameter set at ``current_a`` [A]."""
     return valve_map(current_a, p[MAX_CURRENT], p[DEADBAND], p[MAP_K1], p[MAP_K2],
-                     p[MAX_PRESSURE])
+                     p[MAP_EXTRA_3], p[MAX_PRESSURE])
 
 
 @njit(cache=True)

@@ -186,6 +186,8 @@ SPECS: tuple[ParamSpec, ...] = (
           "motion (eddy currents, a viscous bearing)"),
     _slot(K.LOADING_EXTRA_LOAD_N_S_PER_M, "N s/m", "load c v the loading device loses with "
           "the speed beside the lift law: F_z0 - k_L v^2 - c v"),
+    _slot(K.ACTUATOR_EXTRA_MAP_PA_PER_A3, "Pa/A^3", "static map term k3 (I - I0)^3 beside "
+          "k1, k2 (a map that bends: flow forces, a spring's progression)"),
 )
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}
@@ -200,8 +202,7 @@ def default_config_dir() -> Path:
     """The bundled ``config/`` folder: source tree, then the install prefix's ``share/``."""
     package = Path(__file__).resolve().parents[1]  # landing_gear_sim/
     share = Path("share") / "landing_gear_sim" / "config"
-    # source tree (editable install), the prefix this copy is installed in
-    # (<prefix>/lib/pythonX.Y/site-packages/landing_gear_sim), ROS prefixes, the venv
+    # source tree, this copy's prefix (<prefix>/lib/pythonX.Y/site-packages/…), ROS, venv
     own_prefix = [package.parents[3] / share] if len(package.parents) > 3 else []
     candidates = [
         package.parent / "config",
@@ -265,11 +266,9 @@ class RigParameters:
         """A copy with the named elements switched off (this set when none is named)."""
         if not elements:
             return self
-        unknown = [e for e in elements if e not in ELEMENTS]
-        if unknown:
+        if unknown := [e for e in elements if e not in ELEMENTS]:
             raise ParameterError(
-                f"unknown element {unknown[0]!r}; switchable elements: {', '.join(ELEMENTS)}"
-            )
+                f"unknown element {unknown[0]!r}; switchable elements: {', '.join(ELEMENTS)}")
         return self.replace({f"elements.{e}": False for e in elements},
                             f"--without {','.join(elements)}")
 

@@ -13,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.optimize
 
 from landing_gear_sim.errors import ScenarioError
 from landing_gear_sim.model import keys as K
@@ -252,11 +253,30 @@ def current_for_pressure(params: RigParameters, pressure_pa: float) -> float:
                             f"range 0..{p_max / PA_PER_BAR:g} bar")
     target = pressure_pa / params.number(K.ACTUATOR_GAIN)
     excess = target / k1 if k2 == 0 else (-k1 + math.sqrt(k1 * k1 + 4 * k2 * target)) / (2 * k2)
+    if params.number(K.ACTUATOR_EXTRA_MAP_PA_PER_A3):
+        excess = _map_root(params, target)
     current = params.number(K.ACTUATOR_DEADBAND_CURRENT_A) + excess
     if current > params.number(K.ACTUATOR_MAX_CURRENT_A):
         raise ScenarioError(f"pressure {pressure_pa / PA_PER_BAR:g} bar needs more than the "
                             f"valve's {params.number('actuator.max_current_a'):g} A")
     return current
+
+
+def _map_root(params: RigParameters, target_pa: float) -> float:
+    """The excess current e ≥ 0 where k1 e + k2 e² + k3 e³ first reaches ``target_pa``
+    (inf: not within the valve's range); a map with a cubic term, by bracketing."""
+    k1, k2, k3, max_current, deadband = (params.number(k) for k in (
+        K.ACTUATOR_MAP_K1_PA_PER_A, K.ACTUATOR_MAP_K2_PA_PER_A2, K.ACTUATOR_EXTRA_MAP_PA_PER_A3,
+        K.ACTUATOR_MAX_CURRENT_A, K.ACTUATOR_DEADBAND_CURRENT_A))
+    def error(e: float) -> float:
+        return e * (k1 + e * (k2 + e * k3)) - target_pa
+    grid = np.linspace(0.0, max_current - deadband, 1001)
+    above = np.flatnonzero(error(grid) >= 0.0)  # type: ignore[arg-type]
+    if above.size == 0:
+        return math.inf
+    if above[0] == 0:
+        return 0.0
+    return float(scipy.optimize.brentq(error, grid[above[0] - 1], grid[above[0]]))
 
 
 def rig_test(params: RigParameters, braking: Profile, name: str = "rig_test",

@@ -18,6 +18,7 @@ from landing_gear_sim.diagnosis.diagnose import diagnose
 from landing_gear_sim.diagnosis.families import HIDDEN, REGISTRY
 from landing_gear_sim.diagnosis.families.equation_terms import EquationTerms
 from landing_gear_sim.diagnosis.relations import Relation
+from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
@@ -89,8 +90,9 @@ def test_each_equation_finds_its_own_hidden_term_and_no_other(reference, tmp_pat
     family, hidden = HIDDEN[case]
     drawn = hidden.draw(np.random.default_rng(sum(map(ord, case))), reference)
     runs, calibrated = _campaign(reference, tmp_path, 310, drawn)
-    braking = [br.prepare(r, calibrated) for r in runs if r.braking]
-    found = {library.equation: {s.term.key: s.value for s in library.select(braking, calibrated)}
+    campaign = eq.Campaign(runs, [br.prepare(r, calibrated) for r in runs if r.braking])
+    found = {library.equation: {s.term.key: s.value
+                                for s in library.select(campaign, calibrated)}
              for library in eq.LIBRARIES}
     assert found.pop(family.library.equation) == pytest.approx(drawn, rel=0.1)
     assert not any(found.values()), found
@@ -101,10 +103,36 @@ def test_a_clean_campaign_violates_no_equation_and_says_so(reference, tmp_path):
 
     runs, calibrated = _campaign(reference, tmp_path, 320)
     checks = [c for c in check_campaign(runs, calibrated)
-              if c.relation in (Relation.WHEEL_BALANCE, Relation.FLYWHEEL_BALANCE,
-                                Relation.LOADING_LAW)]
-    assert len(checks) == 3
+              if c.relation in (Relation.VALVE_MAP, Relation.WHEEL_BALANCE,
+                                Relation.FLYWHEEL_BALANCE, Relation.LOADING_LAW)]
+    assert len(checks) == 4
     assert not [c.describe() for c in checks if c.violated]
+
+
+def test_a_known_map_bend_is_read_around_by_the_static_map_fit(reference, tmp_path):
+    """The quasi-static ramp's fit of k1, k2 beside the model's k3: with the bend known, k1
+    comes out as the rig's; without it, the quadratic absorbs the bend."""
+    from landing_gear_sim.calibration.actuator import fit_static_map
+
+    bend = float(np.random.default_rng(9).uniform(-4e6, -2e6))
+    runs, calibrated = _campaign(reference, tmp_path, 302, {K.ACTUATOR_EXTRA_MAP_PA_PER_A3: bend})
+    ramps = [r for r in runs if r.kind == "actuator_ramp"]
+    truth = rig_like(reference, np.random.default_rng(302)).number(K.ACTUATOR_MAP_K1_PA_PER_A)
+    k1 = {known: {e.key: e.value for e in fit_static_map(ramps, calibrated.replace(
+        {K.ACTUATOR_EXTRA_MAP_PA_PER_A3: bend if known else 0.0}, "map"))}[
+        K.ACTUATOR_MAP_K1_PA_PER_A] for known in (True, False)}
+    assert k1[True] == pytest.approx(truth, rel=0.01)
+    assert abs(k1[False] / truth - 1) > 3 * abs(k1[True] / truth - 1)
+
+
+def test_a_bent_map_still_gives_the_current_for_a_pressure(reference):
+    """A stop at constant pressure needs the map's inverse, the cubic term included."""
+    bent = reference.replace({K.ACTUATOR_EXTRA_MAP_PA_PER_A3: -3e6}, "bent")
+    for pressure in (5e5, 20e5, 40e5):
+        current = sc.current_for_pressure(bent, pressure)
+        assert el.valve_static_pressure(bent.vector(), current) == pytest.approx(pressure,
+                                                                                 rel=1e-6)
+    assert sc.current_for_pressure(bent, 40e5) > sc.current_for_pressure(reference, 40e5)
 
 
 def test_the_flywheel_tells_a_load_cell_crosstalk_from_a_bearing_torque(reference, tmp_path):

@@ -31,11 +31,10 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-import scipy.signal
 
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.plausibility import counted_wheel_step
-from landing_gear_sim.calibration.runs import ClassifiedRun, RunKind
+from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.statistics import (
     inverse_variance_weights,
     linear_std,
@@ -47,7 +46,7 @@ from landing_gear_sim.calibration.wheel_angle import (
     brake_ripple,
     checked_ripple,
 )
-from landing_gear_sim.diagnosis.equation_library import equation_checks
+from landing_gear_sim.diagnosis.equation_library import Campaign, equation_checks
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.load_relation import (
     LOAD_SPREAD,
@@ -61,33 +60,27 @@ from landing_gear_sim.diagnosis.relations import (
     Relation,
 )
 from landing_gear_sim.diagnosis.scoring import effective_count
+from landing_gear_sim.diagnosis.settled_valve import (
+    PRESSURE_FLOOR_PA,
+    SETTLED_S,
+    settled_valve,
+)
 from landing_gear_sim.model import keys as K
-from landing_gear_sim.model.actuator import actuator_pressure
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rolling_radius_at
 from landing_gear_sim.model.scenario import (
-    NOISY_CURRENT_A,
     commanded,
-    current_noise_a,
-    logged_to_held,
 )
 from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.units import PA_PER_BAR
 
 FORCE_FLOOR_N = 150.0  # a load-cell offset or crosstalk smaller than this does not matter
-PRESSURE_FLOOR_PA = 0.2 * PA_PER_BAR
 TREND_FLOOR = 0.05  # a brake gain changing by less than 5 % over the range does not matter
-SETTLED_S = 0.3  # after a current change the valve has settled
 MIN_RUNS_FOR_DRIFT = 3
 MAX_BRAKING_SLIP = 0.15  # beyond, the torque balance's derivative error dominates
 RUNOUT_FLOOR = 1e-3  # a ripple below 0.1 % of the wheel speed is within the encoder's noise
 TIMING_FLOOR_S = 1e-3  # a channel out of step by less than a millisecond does not matter
 BRAKE_RUNOUT_FLOOR = 0.01  # a disc's ripple below 1 % of the torque does not matter
-SLOW_A_S = 0.5  # slower current changes: A(s) errors leave no direction-locked residual
-RATE_WINDOW_S = 0.3  # a noisy current's rate of change is its slope over this ...
-RATE_NOISE_Z = 5.0  # ... and counted beyond this many σ of that average's noise
-NOISE_WINDOW_S = 0.5  # a current log's noise is read in pieces this long ...
-NOISE_QUANTILE = 0.2  # ... as this quantile of the pieces' estimates
 
 
 FREE_ROLLING = Relation.FREE_ROLLING
@@ -112,7 +105,7 @@ def check_campaign(runs: Sequence[ClassifiedRun], params: RigParameters) -> list
         checks.extend(_gain_trends(braking, params))
         checks.extend(_pressure_timing(braking, params))
         checks.extend(friction_in_load(braking, params))
-        checks.extend(equation_checks(braking, params))
+    checks.extend(equation_checks(Campaign(runs, braking), params))
     return checks
 
 
@@ -176,59 +169,20 @@ def _run_checks(run: ClassifiedRun, prepared: br.Braking | None, params: RigPara
 
 def _valve_direction(run: ClassifiedRun, params: RigParameters) -> Check | None:
     """Measured minus model pressure where the current fell last, against where it rose
-    last (only where it has changed slowly for SETTLED_S and the valve is between its
-    dead-band and saturation): a static map cannot tell the two apart, a valve with play
-    can. Positive: more pressure on the way down."""
-    noise = _log_noise_a(run)
-    if _unreadable(run, noise):
+    last (on the settled samples, :func:`~.settled_valve.settled_valve`): a static map
+    cannot tell the two apart, a valve with play can. Positive: more pressure on the way
+    down."""
+    valve = settled_valve(run, params)
+    if valve is None:
         return None
-    model = actuator_pressure(params, logged_to_held(run.command_a), run.rate_hz)
-    residual = run.pressure_pa - SensorModel.of(params).pressure_channel(run.time_s, model)
-    change = _current_rate(run, noise)
-    last = np.maximum.accumulate(np.where(change != 0.0, np.arange(change.size), 0))
-    direction = np.sign(change[last])
-    window = max(1, round(SETTLED_S * run.rate_hz))
-    fast = np.abs(change) > SLOW_A_S
-    slow = np.convolve(fast, np.ones(window), mode="full")[:fast.size] == 0
-    band = (model > 2 * PRESSURE_FLOOR_PA) & (model < 0.9 * params.number(
-        K.ACTUATOR_MAX_PRESSURE_PA))
-    falling, rising = (residual[slow & band & (direction == s)] for s in (-1.0, 1.0))
+    falling, rising = (valve.residual_pa[valve.settled & (valve.direction == s)]
+                       for s in (-1.0, 1.0))
     if min(falling.size, rising.size) < MIN_CHECK_S * run.rate_hz:
         return None
     std = math.sqrt(sum(float(np.var(r)) / effective_count(r - r.mean())
                         for r in (falling, rising)))
     return Check(VALVE_DIRECTION, run.name, "slow current changes",
                  float(falling.mean() - rising.mean()), std, PRESSURE_FLOOR_PA, "Pa")
-
-
-def _unreadable(run: ClassifiedRun, noise_a: float) -> bool:
-    """A fast actuator run whose current log is noisy: fed the log (a sweep to 100 Hz keeps
-    it), a valve with play follows the noise both ways, and which way the current last
-    moved means nothing (the quasi-static ramp, fed its denoised command, still tells)."""
-    return run.kind is RunKind.ACTUATOR_DYNAMIC and noise_a > NOISY_CURRENT_A
-
-
-def _log_noise_a(run: ClassifiedRun) -> float:
-    """The current log's noise where the command is quietest [A]: a low quantile of the
-    estimate over NOISE_WINDOW_S pieces (a clean log's 100 Hz sweep read as 1.2 mA of
-    'noise' over the whole run, and the run went unchecked)."""
-    width = max(MIN_SAMPLES, round(NOISE_WINDOW_S * run.rate_hz))
-    pieces = [run.current_a[i:i + width] for i in range(0, run.current_a.size, width)]
-    return float(np.quantile([current_noise_a(p) for p in pieces], NOISE_QUANTILE))
-
-
-def _current_rate(run: ClassifiedRun, noise: float) -> np.ndarray:
-    """How fast the valve's current changes [A/s], (n,); 0 where it holds. A noisy log's
-    rate is the least-squares slope over RATE_WINDOW_S, counted only beyond RATE_NOISE_Z
-    times that slope's noise (10 mA of noise made every sample a 'fast change' on its own,
-    and the relation went unchecked)."""
-    if noise <= NOISY_CURRENT_A:
-        return np.diff(run.current_a, prepend=run.current_a[0]) * run.rate_hz
-    width = 2 * round(RATE_WINDOW_S * run.rate_hz / 2) + 1
-    slope = scipy.signal.savgol_filter(run.current_a, width, 1, deriv=1,
-                                       delta=1.0 / run.rate_hz, mode="nearest")
-    floor = RATE_NOISE_Z * noise * run.rate_hz * math.sqrt(12.0 / width ** 3)
-    return np.where(np.abs(slope) > floor, slope, 0.0)
 
 
 def _wheel_angle(run: ClassifiedRun, params: RigParameters) -> Check | None:

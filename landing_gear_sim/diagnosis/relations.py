@@ -33,6 +33,7 @@ class Relation(str, enum.Enum):
     WHEEL_BALANCE = "wheel turned by the tyre and the brake alone"
     FLYWHEEL_BALANCE = "flywheel slowed by F_x and the drag alone"
     LOADING_LAW = "vertical load follows F_z0 − k_L v²"
+    VALVE_MAP = "valve settles on its quadratic static map"
 
     def __str__(self) -> str:
         return self.value
@@ -63,6 +64,7 @@ _WHERE = {
     "WHEEL_BALANCE": ("wheel", "longitudinal_force_n"),
     "FLYWHEEL_BALANCE": ("flywheel", "flywheel_speed_rad_s"),
     "LOADING_LAW": ("loading device", "vertical_load_n"),
+    "VALVE_MAP": ("valve", "pressure_pa"),
 }
 @dataclass(frozen=True)
 class Check:

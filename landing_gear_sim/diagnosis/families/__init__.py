@@ -44,6 +44,7 @@ REGISTRY: tuple[Family, ...] = tuple(sorted((
     gain_law.FAMILY,
     run_drift.FAMILY,
     load.FAMILY,
+    equation_terms.VALVE_FAMILY,
     equation_terms.WHEEL_FAMILY,
     equation_terms.FLYWHEEL_FAMILY,
     equation_terms.LOADING_FAMILY,

@@ -23,6 +23,7 @@ import numpy as np
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun, Selector
 from landing_gear_sim.diagnosis.catalogue import Candidate
+from landing_gear_sim.diagnosis.equation_library import Campaign
 from landing_gear_sim.diagnosis.findings import Signature
 from landing_gear_sim.diagnosis.relations import Check, Relation, violations
 from landing_gear_sim.model.parameters import RigParameters
@@ -50,6 +51,11 @@ class Evidence:
         """The braking runs' filtered signals under the model (prepared once, when a
         family asks)."""
         return [br.prepare(r, self.model) for r in self.runs if r.braking]
+
+    @property
+    def campaign(self) -> Campaign:
+        """The runs as the equations' libraries read them."""
+        return Campaign(self.runs, self.braking)
 
 
 @dataclass(frozen=True)

@@ -12,12 +12,21 @@ is left when none of those is called for or accepted.
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
+from landing_gear_sim.calibration.runs import Selector
 from landing_gear_sim.diagnosis import equation_library as eq
-from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
+from landing_gear_sim.diagnosis.catalogue import (
+    ACTUATOR_RUNS,
+    BRAKE_RUNS,
+    FRICTION,
+    PRESSURE,
+    STATIC_MAP,
+    WHEEL,
+    Candidate,
+)
 from landing_gear_sim.diagnosis.families.base import (
     Evidence,
     Family,
@@ -37,9 +46,11 @@ class EquationTerms(Family):
     """The generic slot of one equation's ``library``; ``free``: the parameters the
     calibration owns in it, fitted again with a term; ``channels``: those compared."""
 
-    library: ClassVar[eq.Library]
+    library: ClassVar[eq.Library[Any]]
     free: ClassVar[tuple[str, ...]]
     channels: ClassVar[tuple[str, ...]]
+    runs: ClassVar[tuple[Selector, ...]] = BRAKE_RUNS
+    held_out: ClassVar[tuple[Selector, ...]] = ()
     rank = RANK
 
     def __init_subclass__(cls) -> None:
@@ -49,25 +60,26 @@ class EquationTerms(Family):
 
     def propose(self, evidence: Evidence) -> list[Proposal]:
         """The kept terms, started at their fit, fitted with the parameters the calibration
-        owns in the equation on the braking runs."""
+        owns in the equation on the family's runs."""
         if not evidence.violated(self.library.relation):
             return []
-        chosen = self.library.select(evidence.braking, evidence.model)
+        chosen = self.library.select(evidence.campaign, evidence.model)
         if not chosen:
             return []
         return [Proposal(term_candidate(
             self, [s.term.key for s in chosen],
             [float(np.clip(s.value, -0.9 * s.term.bound, 0.9 * s.term.bound)) for s in chosen],
-            [(-s.term.bound, s.term.bound) for s in chosen], self.free, BRAKE_RUNS,
-            self.channels))]
+            [(-s.term.bound, s.term.bound) for s in chosen], self.free, self.runs,
+            self.channels, held_out=self.held_out))]
 
     def formula(self, candidate: Candidate, params: RigParameters) -> str:
-        written = " ".join(f"{signed(-params.number(t.key), t.unit)}{t.symbol}"
+        sign = self.library.sign
+        written = " ".join(f"{signed(sign * params.number(t.key), t.unit)}{t.symbol}"
                            for t in self.library.terms if t.key in candidate.keys)
         return self.library.law(written, params)
 
 
-def _hidden(name: str, library: eq.Library, key: str, span: tuple[float, float]) -> Hidden:
+def _hidden(name: str, library: eq.Library[Any], key: str, span: tuple[float, float]) -> Hidden:
     """An effect in ``library``'s slot ``key``, drawn in ``span`` (its SI unit), found within
     TOLERANCE."""
     return Hidden(name, str(library.equation), lambda rng, datasheet: {key: rng.uniform(*span)},
@@ -100,6 +112,18 @@ class LoadingTerms(EquationTerms):
     hidden = (_hidden("load_sag", eq.LOADING, K.LOADING_EXTRA_LOAD_N_S_PER_M, (20.0, 60.0)),)
 
 
+class ValveTerms(EquationTerms):
+    name = "valve_equation"
+    library = eq.VALVE
+    free = STATIC_MAP
+    channels = PRESSURE
+    runs = ACTUATOR_RUNS
+    held_out = BRAKE_RUNS
+    hidden = (_hidden("valve_map_bend", eq.VALVE, K.ACTUATOR_EXTRA_MAP_PA_PER_A3,
+                      (-4e6, -1.5e6)),)
+
+
+VALVE_FAMILY = ValveTerms()
 WHEEL_FAMILY = WheelTerms()
 FLYWHEEL_FAMILY = FlywheelTerms()
 LOADING_FAMILY = LoadingTerms()

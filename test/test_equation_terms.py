@@ -167,6 +167,23 @@ def test_an_effect_no_family_names_is_discovered_in_its_equation(reference, tmp_
     assert finding.parameters[hidden.key] == pytest.approx(truth, rel=hidden.tolerance)
 
 
+def test_a_valve_map_that_bends_is_discovered_in_the_valve_not_named_a_valve_effect(
+        reference, tmp_path):
+    """The static map bends beyond the quadratic the calibration fits (the test draws the
+    bend): fitted on the actuator runs, the family must win on the braking runs' pressure,
+    and no catalogued valve effect (delay, offset) may take its place."""
+    rng = np.random.default_rng(350)
+    bend = float(rng.uniform(-3.5e6, -1.5e6))
+    rig = rig_like(reference, rng).replace({K.ACTUATOR_EXTRA_MAP_PA_PER_A3: bend}, "bent")
+    generate_campaign(tmp_path, rig, 350, RUNS)
+    result = diagnose(read_campaign(tmp_path).runs, reference)
+    assert [f.cause for f in result.findings] == ["discovered"], result.findings
+    finding = result.findings[0]
+    assert finding.family == "valve" and finding.held_out < 0
+    assert finding.term.startswith("P_static = ") and "e³" in finding.term
+    assert finding.parameters["extra_map_pa_per_a3"] == pytest.approx(bend, rel=0.2)
+
+
 def test_of_two_causes_beside_a_discovered_term_only_the_one_it_replaces_goes(reference,
                                                                                monkeypatch):
     """Each cause is scored again from the extended model without it (here: told by a stand-

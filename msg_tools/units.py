@@ -51,7 +51,8 @@ def parse_unit(text: str, quantity: str) -> str | None:
 DISPLAY: dict[str, tuple[str, float]] = {
     "s": ("ms", 1e3), "A": ("mA", 1e3), "Pa": ("bar", 1.0 / PA_PER_BAR),
     "N m/Pa": ("N m/bar", PA_PER_BAR), "1/N": ("%/kN", 1e5), "1": ("%", 100.0),
-    "N": ("kN", 1e-3), "1/run": ("%/run", 100.0),
+    "N": ("kN", 1e-3), "1/run": ("%/run", 100.0), "Pa/A": ("bar/A", 1.0 / PA_PER_BAR),
+    "Pa/A^2": ("bar/A²", 1.0 / PA_PER_BAR), "Pa/A^3": ("bar/A³", 1.0 / PA_PER_BAR),
 }
 """SI unit -> the unit a brake engineer reads a term's value in, and the factor to it."""
 

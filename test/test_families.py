@@ -89,6 +89,7 @@ def test_a_term_of_a_law_is_written_with_its_sign_and_display_unit():
     assert signed(-0.034) == "− 0.034"
     assert signed(-1.2e-5, "1/N", ".2f") == "− 1.20 %/kN"
     assert signed(0.02, "1", ".2f") == "+ 2.00 %"
+    assert signed(-1.87e6, "Pa/A^3") == "− 18.7 bar/A³"
 
 
 def test_candidates_and_findings_take_keywords_only():

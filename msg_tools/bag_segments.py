@@ -20,11 +20,12 @@ from __future__ import annotations
 
 import os
 import shutil
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import yaml
-from rosbags.rosbag2 import Reader, Writer
+from rosbags.rosbag2 import Reader, ReaderError, Writer
 
 from .bag_io import BAG_VERSION, STORAGE, TYPESTORE
 from .errors import RunFormatError
@@ -102,24 +103,7 @@ class SegmentedBagWriter:
             self._join_segments()
 
     def _join_segments(self) -> None:
-        work = self.path / JOINING
-        shutil.rmtree(work, ignore_errors=True)
-        segments = [self.path / s["relative_file_paths"][0] for s in self._closed]
-        with Reader(self.path) as reader, Writer(
-                work / self.path.name, version=BAG_VERSION,
-                storage_plugin=STORAGE[self._storage]) as writer:
-            connections = {topic: writer.add_connection(topic, kind, typestore=TYPESTORE)
-                           for topic, kind in self._topics.items()}
-            for connection, log_time_ns, raw in reader.messages():
-                writer.write(connections[connection.topic], log_time_ns, raw)
-        info = yaml.safe_load((writer.path / "metadata.yaml").read_text())[META]
-        name = info["relative_file_paths"][0]
-        os.replace(writer.path / name, self.path / name)
-        os.replace(writer.path / "metadata.yaml", self.path / "metadata.yaml")
-        for segment in segments:
-            segment.unlink()
-        shutil.rmtree(work, ignore_errors=True)
-        self._closed = [info]
+        self._closed = [_join(self.path, self._topics, self._storage)]
 
     def _open(self) -> None:
         shutil.rmtree(self.path / OPEN_SEGMENT, ignore_errors=True)
@@ -165,3 +149,51 @@ class SegmentedBagWriter:
         temporary = self.path / "metadata.yaml.tmp"
         temporary.write_text(yaml.safe_dump({META: merged}, sort_keys=False))
         os.replace(temporary, self.path / "metadata.yaml")
+
+
+def join_bag(path: Path, say: Callable[[str], object] | None = None) -> tuple[int, int]:
+    """Join an existing bag's storage files into one, as a writer's close does (a recording
+    stopped by a signal keeps its segments): the joined file is listed in place of the
+    segments in one atomic metadata write, then the segments go. ``say`` hears when a join
+    starts (~11 µs a message: a 300 s run's 1.5 M take ~16 s). Returns the number of files
+    joined (1: already one, nothing done) and of messages."""
+    path = Path(path)
+    try:
+        info = yaml.safe_load((path / "metadata.yaml").read_text())[META]
+        storage = info["storage_identifier"]
+        files = info["relative_file_paths"]
+        with Reader(path) as reader:
+            topics = {c.topic: c.msgtype for c in reader.connections}
+    except (OSError, KeyError, TypeError, yaml.YAMLError, ReaderError) as error:
+        raise RunFormatError(f"{path}: not a readable rosbag2 folder ({error})") from error
+    if storage not in STORAGE:
+        raise RunFormatError(f"{path}: storage {storage!r} cannot be joined (mcap, sqlite3)")
+    if len(files) > 1:
+        if say is not None:
+            say(f"joining {len(files)} segments ({info['message_count']} messages) …")
+        info = _join(path, topics, storage)
+    return len(files), int(info["message_count"])
+
+
+def _join(path: Path, topics: dict[str, str], storage: str) -> dict[str, Any]:
+    """Write the bag ``path``'s messages into one storage file beside its segments, list it
+    in their place, remove them; the joined file's metadata."""
+    work = path / JOINING
+    shutil.rmtree(work, ignore_errors=True)
+    listed = yaml.safe_load((path / "metadata.yaml").read_text())[META]["relative_file_paths"]
+    segments = [path / name for name in listed]
+    with Reader(path) as reader, Writer(work / path.name, version=BAG_VERSION,
+                                        storage_plugin=STORAGE[storage]) as writer:
+        connections = {topic: writer.add_connection(topic, kind, typestore=TYPESTORE)
+                       for topic, kind in topics.items()}
+        for connection, log_time_ns, raw in reader.messages():
+            writer.write(connections[connection.topic], log_time_ns, raw)
+    info: dict[str, Any] = yaml.safe_load((writer.path / "metadata.yaml").read_text())[META]
+    name = info["relative_file_paths"][0]
+    os.replace(writer.path / name, path / name)
+    os.replace(writer.path / "metadata.yaml", path / "metadata.yaml")
+    for segment in segments:
+        if segment.name != name:
+            segment.unlink()
+    shutil.rmtree(work, ignore_errors=True)
+    return info

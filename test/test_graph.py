@@ -319,6 +319,30 @@ def test_segments_are_kept_when_asked(tmp_path, when):
     assert not (tmp_path / "bag" / OPEN_SEGMENT).exists()
 
 
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_the_join_command_joins_the_segments_a_stopped_recording_kept(tmp_path, storage,
+                                                                        capsys):
+    from landing_gear_sim.cli import main
+
+    _segmented(tmp_path / "bag", storage).close(join=False)
+    assert main(["join", str(tmp_path / "bag")]) == 0
+    assert "3 segments joined into one file (30 messages)" in capsys.readouterr().out
+    assert _values(tmp_path / "bag") == list(range(30))
+    assert sorted(p.name for p in (tmp_path / "bag").iterdir()) == [
+        f"bag.{'db3' if storage == 'sqlite3' else 'mcap'}", "metadata.yaml"]
+    assert main(["join", str(tmp_path / "bag")]) == 0
+    assert "one storage file already (30 messages)" in capsys.readouterr().out
+
+
+def test_the_join_command_refuses_a_folder_that_is_no_bag_in_one_line(tmp_path, capsys):
+    from landing_gear_sim.cli import main
+
+    (tmp_path / "notes").mkdir()
+    assert main(["join", str(tmp_path / "notes")]) == 2
+    error = capsys.readouterr().err
+    assert "not a readable rosbag2 folder" in error and len(error.splitlines()) == 1
+
+
 def test_a_crashed_writer_leaves_a_bag_with_every_closed_segment(tmp_path):
     writer = SegmentedBagWriter(tmp_path / "bag", {"/x": "std_msgs/msg/Float64"})
     for k in range(25):

@@ -1,4 +1,4 @@
-"""The model and graph commands: simulate, rig, bode, params, campaign, convert."""
+"""The model and graph commands: simulate, rig, bode, params, campaign, convert, join."""
 
 from __future__ import annotations
 
@@ -95,6 +95,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_storage_argument(conv)
     conv.add_argument("--mapping", type=InputPath, help="column-mapping file for a CSV input")
     conv.set_defaults(func=cmd_convert)
+
+    join = sub.add_parser("join", help="join a recorded bag's segments into one storage file "
+                                       "(a long recording stopped by a signal keeps them)")
+    join.add_argument("bag", type=InputPath, help="a bag folder")
+    join.set_defaults(func=cmd_join)
 
 
 def _summary(result: SimulationResult) -> str:
@@ -282,3 +287,12 @@ def cmd_convert(args: argparse.Namespace) -> int:
     return 0
 
 
+
+
+def cmd_join(args: argparse.Namespace) -> int:
+    from msg_tools.bag_segments import join_bag
+
+    files, messages = join_bag(args.bag, say=print)
+    print(f"{args.bag}: one storage file already ({messages} messages)" if files == 1 else
+          f"{args.bag}: {files} segments joined into one file ({messages} messages)")
+    return 0

@@ -156,7 +156,8 @@ class RecorderNode(GraphNode):
         self._writer.close(join=join)
         kept = "" if join or not self._writer.joins else (
             f"; stopped by a signal: its {self._writer.segment_count} segments kept, not "
-            "joined (joining that many messages takes longer than a stop may)")
+            "joined (joining that many messages takes longer than a stop may; "
+            f"`landing-gear-sim join {self._writer.path}` joins them)")
         say(self, f"bag closed: {self._writer.path} ({self._written} samples, "
                   f"{self._writer.message_count} messages{kept})")
 

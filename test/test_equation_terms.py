@@ -170,7 +170,7 @@ def test_an_effect_no_family_names_is_discovered_in_its_equation(reference, tmp_
 def test_a_valve_map_that_bends_is_discovered_in_the_valve_not_named_a_valve_effect(
         reference, tmp_path):
     """The static map bends beyond the quadratic the calibration fits (the test draws the
-    bend): fitted on the actuator runs, the family must win on the braking runs' pressure,
+    bend): fitted on the quasi-static ramp, the family must win on the braking runs' pressure,
     and no catalogued valve effect (delay, offset) may take its place."""
     rng = np.random.default_rng(350)
     bend = float(rng.uniform(-3.5e6, -1.5e6))
@@ -181,7 +181,7 @@ def test_a_valve_map_that_bends_is_discovered_in_the_valve_not_named_a_valve_eff
     finding = result.findings[0]
     assert finding.family == "valve" and finding.held_out < 0
     assert finding.term.startswith("P_static = ") and "e³" in finding.term
-    assert finding.parameters["extra_map_pa_per_a3"] == pytest.approx(bend, rel=0.2)
+    assert finding.parameters["extra_map_pa_per_a3"] == pytest.approx(bend, rel=0.1)
 
 
 def test_of_two_causes_beside_a_discovered_term_only_the_one_it_replaces_goes(reference,

@@ -16,10 +16,9 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from landing_gear_sim.calibration.runs import Selector
+from landing_gear_sim.calibration.runs import RunKind, Selector
 from landing_gear_sim.diagnosis import equation_library as eq
 from landing_gear_sim.diagnosis.catalogue import (
-    ACTUATOR_RUNS,
     BRAKE_RUNS,
     FRICTION,
     PRESSURE,
@@ -117,7 +116,7 @@ class ValveTerms(EquationTerms):
     library = eq.VALVE
     free = STATIC_MAP
     channels = PRESSURE
-    runs = ACTUATOR_RUNS
+    runs = (RunKind.ACTUATOR_RAMP,)  # where the map lives: A(s) pulled k3 31 % off once
     held_out = BRAKE_RUNS
     hidden = (_hidden("valve_map_bend", eq.VALVE, K.ACTUATOR_EXTRA_MAP_PA_PER_A3,
                       (-4e6, -1.5e6)),)

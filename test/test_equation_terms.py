@@ -135,6 +135,57 @@ def test_a_bent_map_still_gives_the_current_for_a_pressure(reference):
     assert sc.current_for_pressure(bent, 40e5) > sc.current_for_pressure(reference, 40e5)
 
 
+def test_a_bearing_torque_the_model_holds_leaves_free_rolling_holding(reference, tmp_path):
+    """The tyre pushes a bearing's torque before the brake acts: with the slot known the
+    free-rolling relation holds; without it, it is violated."""
+    from landing_gear_sim.diagnosis.consistency import FREE_ROLLING, check_campaign
+
+    torque = float(np.random.default_rng(11).uniform(60.0, 120.0))
+    runs, calibrated = _campaign(reference, tmp_path, 303, {K.WHEEL_EXTRA_TORQUE_N_M: torque})
+    for known, broken in ((0.0, True), (torque, False)):
+        model = calibrated.replace({K.WHEEL_EXTRA_TORQUE_N_M: known}, "bearing")
+        checks = [c for c in check_campaign(runs, model) if c.relation == FREE_ROLLING]
+        assert checks and any(c.violated for c in checks) == broken, [
+            c.describe() for c in checks]
+
+
+def test_a_later_family_is_tried_when_the_accepted_term_leaves_its_relation_violated(
+        reference, monkeypatch):
+    """A brake gain law (rank 6) once took a bearing's torque and left free rolling
+    violated; the wheel's equation (rank 8) must still be tried and, explaining more, win.
+    When the accepted term leaves nothing of it, the search stops there."""
+    from landing_gear_sim.diagnosis import discovered as d
+    from landing_gear_sim.diagnosis.families.base import Family, Proposal
+
+    tried: list[str] = []
+
+    class Stand(Family):
+        def __init__(self, name: str, rank: int, relation: Relation) -> None:
+            self.name, self.rank, self.relations = name, rank, (relation,)
+
+        def propose(self, evidence):
+            tried.append(self.name)
+            return [Proposal(candidate=None)]  # type: ignore[arg-type]
+
+        def formula(self, candidate, params):
+            return ""
+
+    law, bearing = Stand("law", 6, Relation.GAIN_IN_PRESSURE), Stand("wheel", 8,
+                                                                     Relation.FREE_ROLLING)
+    accepted = type("Accepted", (), {"finding": type("F", (), {"accepted": True})()})
+    scored = {"law": accepted(), "wheel": accepted()}
+    monkeypatch.setattr(d, "REGISTRY", (law, bearing))
+    monkeypatch.setattr(d, "_score_discovered", lambda family, *_: scored[family.name])
+    monkeypatch.setattr(d, "_better", lambda first, second, runs: second)
+    monkeypatch.setattr(d, "_called_for", lambda family, s, evidence: s)
+    for left, found, names in (({Relation.FREE_ROLLING}, "wheel", ["law", "wheel"]),
+                               (set(), "law", ["law"])):
+        tried.clear()
+        monkeypatch.setattr(d, "_left_violated", lambda s, runs, left=left: left)
+        assert d.discover([], reference, reference, {}, [], [], print) is scored[found]
+        assert tried == names
+
+
 def test_the_flywheel_tells_a_load_cell_crosstalk_from_a_bearing_torque(reference, tmp_path):
     """Both make the F_x channel read a force in free rolling; only the crosstalk is a force
     the flywheel does not feel."""

@@ -65,6 +65,7 @@ from landing_gear_sim.diagnosis.settled_valve import (
     SETTLED_S,
     settled_valve,
 )
+from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rolling_radius_at
@@ -236,14 +237,16 @@ def _zero_current(run: ClassifiedRun, params: RigParameters) -> Check | None:
 
 def free_rolling_excess(b: br.Braking, params: RigParameters) -> tuple[np.ndarray, np.ndarray]:
     """The samples before the brake acts (mask), and the F_x there (the model's crosstalk
-    taken off the reading) less the wheel's inertia force J_w ω̇ / r [N]: what the load cell
-    reads beyond the physics."""
+    taken off the reading) less the wheel's inertia force J_w ω̇ / r and the force the tyre
+    pushes the model's own wheel torque with (its generic slot: a bearing's) [N]: what the
+    load cell reads beyond the physics."""
     m = br.free_rolling(b)
     radius = rolling_radius_at(params, b.load[m])
-    inertia = params.number(K.WHEEL_INERTIA_KG_M2) * b.wheel_rate[m] / radius
+    torque = (params.number(K.WHEEL_INERTIA_KG_M2) * b.wheel_rate[m]
+              + el.wheel_extra_torque(params.vector(), b.wheel[m]))
     force = SensorModel.of(params).true_longitudinal(b.run.longitudinal_force_n[m],
                                                      b.run.vertical_load_n[m])
-    return m, force - inertia
+    return m, force - torque / radius
 
 
 def _free_rolling(b: br.Braking, params: RigParameters) -> Check | None:

@@ -102,9 +102,10 @@ class Family(abc.ABC):
     """One family of terms the catalogue lacks (see the module docstring): ``name`` in the
     registry, ``reports`` the family a finding names (several mechanisms may share one:
     an encoder's ripple and a disc's run-out are both ``wheel_angle``). ``rank`` orders the
-    registry: a family accepted at one rank ends the search; families of one rank are all
-    scored and the better kept (a drift through runs in rising pressure order reads as a
-    pressure law, and the reverse)."""
+    registry: a family accepted at one rank ends the search, unless its model leaves a
+    later family's relation violated; families of one rank are all scored and the better
+    kept (a drift through runs in rising pressure order reads as a pressure law, and the
+    reverse)."""
 
     name: ClassVar[str]
     reports: ClassVar[str]

@@ -42,8 +42,8 @@ def discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: Rig
     show, or None when no family is called for: the families of REGISTRY by rank, until
     one rank accepts a term that leaves no later family's relation violated (the better is
     kept: :func:`_better`). A wheel bearing's torque once read as a brake gain falling with
-    the pressure (rank 6, held out −45) and left the wheel's balance violated; its own
-    equation's term, at rank 8, was never tried."""
+    the pressure (rank 6, held out −45) and left free rolling violated; its own equation's
+    term, at rank 8, was never tried."""
     evidence = Evidence(runs, model, checks, signatures)
     best: tuple[Family, Scored] | None = None
     left: tuple[Scored | None, set[Relation]] = (None, set())
@@ -91,7 +91,7 @@ def _better(first: Scored | None, second: Scored | None,
 
 
 def _violated_under(scored: Scored, runs: Sequence[ClassifiedRun]) -> int:
-    """How many relations the model ``scored`` fitted leaves violated."""
+    """How many checks the model ``scored`` fitted leaves violated."""
     return len(violations(check_campaign(runs, scored.fit.params)))
 
 

@@ -1,18 +1,19 @@
 """Each equation's library of terms, and its error regressed on it (issue 29).
 
 Every effect, catalogued or not, is a missing term in one of the rig's equations. For the
-wheel's torque balance, the flywheel's momentum balance and the loading device's law, the
-error is computed from the measured signals under the model (the other equations' terms
-measured) over every braking run's samples that carry it, thinned to the filter's bandwidth.
+valve's static map, the wheel's torque balance, the flywheel's momentum balance and the
+loading device's law, the error is computed from the measured signals under the model (the
+other equations' terms measured) over the samples that carry it: the actuator runs' settled
+ones for the valve, every braking run's thinned to the filter's bandwidth for the others.
 It is regressed on the equation's library — the terms of its generic slot in the plant
-(``wheel.extra_*``, ``flywheel.extra_*``, ``loading.extra_*``), beside the terms whose
-coefficients the calibration owns (k_b P in the wheel's; the flywheel's mass and drag; the
-lift) — by a sparse solver (scikit-learn's LARS lasso, BIC). A term the lasso keeps is
-significant when an ordinary fit of the kept and owned terms finds it against the error's own
-noise (t over the error's effective count, above :data:`Z_VIOLATED`) and large enough to
-matter (:data:`MIN_EFFECT` of the equation's scale): the equation's relation
-(:class:`~.relations.Relation`) is then violated, and the equation's family
-(:mod:`~.families.equation_terms`) proposes the term.
+(``actuator.extra_*``, ``wheel.extra_*``, ``flywheel.extra_*``, ``loading.extra_*``),
+beside the terms whose coefficients the calibration owns (the map's 1, e, e²; k_b P in the
+wheel's; the flywheel's mass and drag; the lift) — by a sparse solver (scikit-learn's LARS
+lasso, BIC). A term the lasso keeps is significant when an ordinary fit of the kept and owned
+terms finds it against the error's own noise (t over the error's effective count, above
+:data:`Z_VIOLATED`) and large enough to matter (:data:`MIN_EFFECT` of the equation's scale):
+the equation's relation (:class:`~.relations.Relation`) is then violated, and the equation's
+family (:mod:`~.families.equation_terms`) proposes the term.
 """
 
 from __future__ import annotations

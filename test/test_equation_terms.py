@@ -176,12 +176,13 @@ def test_a_later_family_is_tried_when_the_accepted_term_leaves_its_relation_viol
     scored = {"law": accepted(), "wheel": accepted()}
     monkeypatch.setattr(d, "REGISTRY", (law, bearing))
     monkeypatch.setattr(d, "_score_discovered", lambda family, *_: scored[family.name])
-    monkeypatch.setattr(d, "_better", lambda first, second, runs: second)
+    monkeypatch.setattr(d, "_better", lambda first, second, violated: second)
     monkeypatch.setattr(d, "_called_for", lambda family, s, evidence: s)
     for left, found, names in (({Relation.FREE_ROLLING}, "wheel", ["law", "wheel"]),
                                (set(), "law", ["law"])):
         tried.clear()
-        monkeypatch.setattr(d, "_left_violated", lambda s, runs, left=left: left)
+        monkeypatch.setattr(d, "_violated_under", lambda s, runs, left=left: [
+            type("Violated", (), {"relation": r})() for r in left])
         assert d.discover([], reference, reference, {}, [], [], print) is scored[found]
         assert tried == names
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 from landing_gear_sim.calibration.identify import Progress
@@ -23,7 +23,7 @@ from landing_gear_sim.diagnosis.consistency import check_campaign
 from landing_gear_sim.diagnosis.families import REGISTRY, Evidence, Family, Proposal
 from landing_gear_sim.diagnosis.families.wheel_skew import wheel_lags
 from landing_gear_sim.diagnosis.findings import Finding, Signature
-from landing_gear_sim.diagnosis.relations import Check, Relation, violations
+from landing_gear_sim.diagnosis.relations import Check, violations
 from landing_gear_sim.diagnosis.scoring import (
     HELD_OUT_THRESHOLD,
     Scored,
@@ -45,19 +45,18 @@ def discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: Rig
     the pressure (rank 6, held out −45) and left free rolling violated; its own equation's
     term, at rank 8, was never tried."""
     evidence = Evidence(runs, model, checks, signatures)
+    violated = _Violated(runs)
     best: tuple[Family, Scored] | None = None
-    left: tuple[Scored | None, set[Relation]] = (None, set())
     for _, members in itertools.groupby(REGISTRY, key=lambda f: f.rank):
         group = list(members)
         if best is not None and best[1].finding.accepted:
-            if left[0] is not best[1]:
-                left = (best[1], _left_violated(best[1], runs))
-            group = [f for f in group if left[1] & set(f.relations)]
+            left = {c.relation for c in violated(best[1])}
+            group = [f for f in group if left & set(f.relations)]
         for family in group:
             for proposal in family.propose(evidence):
                 scored = _score_discovered(family, proposal, runs, model, datasheet, scales,
                                            signatures, say)
-                if scored is not None and (best is None or _better(best[1], scored, runs)
+                if scored is not None and (best is None or _better(best[1], scored, violated)
                                            is scored):
                     best = (family, scored)
     return None if best is None else _called_for(*best, evidence)
@@ -74,7 +73,7 @@ def _called_for(family: Family, scored: Scored, evidence: Evidence) -> Scored:
 
 
 def _better(first: Scored | None, second: Scored | None,
-            runs: Sequence[ClassifiedRun]) -> Scored | None:
+            violated: Callable[[Scored], list[Check]]) -> Scored | None:
     """The accepted one; of two accepted, the one that leaves fewer relations violated, then
     the one that predicts the held-out runs better (a drift through a campaign in rising
     pressure order fits a pressure law nearly as well in sample: ΔBIC −94 against −115
@@ -86,18 +85,28 @@ def _better(first: Scored | None, second: Scored | None,
         if not both:
             return not s.finding.accepted, 0, s.finding.delta_bic or 0.0
         held_out = s.finding.held_out if s.finding.held_out is not None else math.inf
-        return False, _violated_under(s, runs), held_out
+        return False, len(violated(s)), held_out
     return min(first, second, key=rank)
 
 
-def _violated_under(scored: Scored, runs: Sequence[ClassifiedRun]) -> int:
-    """How many checks the model ``scored`` fitted leaves violated."""
-    return len(violations(check_campaign(runs, scored.fit.params)))
+def _violated_under(scored: Scored, runs: Sequence[ClassifiedRun]) -> list[Check]:
+    """The checks the model ``scored`` fitted leaves violated."""
+    return violations(check_campaign(runs, scored.fit.params))
 
 
-def _left_violated(scored: Scored, runs: Sequence[ClassifiedRun]) -> set[Relation]:
-    """The relations the model ``scored`` fitted leaves violated."""
-    return {c.relation for c in violations(check_campaign(runs, scored.fit.params))}
+class _Violated:
+    """:func:`_violated_under` of each scored model, once (a check of the campaign prepares
+    every run again: seconds; the search asks it of the best model at every rank and of both
+    models it compares)."""
+
+    def __init__(self, runs: Sequence[ClassifiedRun]) -> None:
+        self._runs = runs
+        self._seen: dict[int, tuple[Scored, list[Check]]] = {}  # the model kept: ids stay
+
+    def __call__(self, scored: Scored) -> list[Check]:
+        if id(scored) not in self._seen:
+            self._seen[id(scored)] = (scored, _violated_under(scored, self._runs))
+        return self._seen[id(scored)][1]
 
 
 @dataclass(frozen=True)

@@ -252,10 +252,12 @@ def current_for_pressure(params: RigParameters, pressure_pa: float) -> float:
         raise ScenarioError(f"pressure {pressure_pa / PA_PER_BAR:g} bar is outside the valve "
                             f"range 0..{p_max / PA_PER_BAR:g} bar")
     target = pressure_pa / params.number(K.ACTUATOR_GAIN)
-    excess = target / k1 if k2 == 0 else (-k1 + math.sqrt(k1 * k1 + 4 * k2 * target)) / (2 * k2)
     if params.number(K.ACTUATOR_EXTRA_MAP_PA_PER_A3):
-        excess = _map_root(params, target)
-    current = params.number(K.ACTUATOR_DEADBAND_CURRENT_A) + excess
+        current = _map_root(params, target)
+    else:
+        excess = target / k1 if k2 == 0 else (
+            -k1 + math.sqrt(k1 * k1 + 4 * k2 * target)) / (2 * k2)
+        current = params.number(K.ACTUATOR_DEADBAND_CURRENT_A) + excess
     if current > params.number(K.ACTUATOR_MAX_CURRENT_A):
         raise ScenarioError(f"pressure {pressure_pa / PA_PER_BAR:g} bar needs more than the "
                             f"valve's {params.number('actuator.max_current_a'):g} A")
@@ -263,19 +265,23 @@ def current_for_pressure(params: RigParameters, pressure_pa: float) -> float:
 
 
 def _map_root(params: RigParameters, target_pa: float) -> float:
-    """The excess current e ≥ 0 where k1 e + k2 e² + k3 e³ first reaches ``target_pa``
-    (inf: not within the valve's range); a map with a cubic term, by bracketing."""
-    k1, k2, k3, max_current, deadband = (params.number(k) for k in (
-        K.ACTUATOR_MAP_K1_PA_PER_A, K.ACTUATOR_MAP_K2_PA_PER_A2, K.ACTUATOR_EXTRA_MAP_PA_PER_A3,
-        K.ACTUATOR_MAX_CURRENT_A, K.ACTUATOR_DEADBAND_CURRENT_A))
-    def error(e: float) -> float:
-        return e * (k1 + e * (k2 + e * k3)) - target_pa
-    grid = np.linspace(0.0, max_current - deadband, 1001)
-    above = np.flatnonzero(error(grid) >= 0.0)  # type: ignore[arg-type]
+    """The current [A] at which the model's own static map (its cubic term included: no
+    closed-form inverse) first reaches ``target_pa``, bracketed on a grid of the valve's
+    range (inf: it never does)."""
+    from landing_gear_sim.model import elements as el  # numba: loaded for a bent map only
+
+    p = params.vector()
+
+    def error(current_a: np.ndarray | float) -> np.ndarray | float:
+        return el.valve_static_pressure(p, current_a) - target_pa
+
+    grid = np.linspace(params.number(K.ACTUATOR_DEADBAND_CURRENT_A),
+                       params.number(K.ACTUATOR_MAX_CURRENT_A), 1001)
+    above = np.flatnonzero(np.asarray(error(grid)) >= 0.0)
     if above.size == 0:
         return math.inf
     if above[0] == 0:
-        return 0.0
+        return float(grid[0])
     return float(scipy.optimize.brentq(error, grid[above[0] - 1], grid[above[0]]))
 
 

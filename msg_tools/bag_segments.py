@@ -103,7 +103,8 @@ class SegmentedBagWriter:
             self._join_segments()
 
     def _join_segments(self) -> None:
-        self._closed = [_join(self.path, self._topics, self._storage)]
+        files = [s["relative_file_paths"][0] for s in self._closed]
+        self._closed = [_join(self.path, files, self._topics, self._storage)]
 
     def _open(self) -> None:
         shutil.rmtree(self.path / OPEN_SEGMENT, ignore_errors=True)
@@ -171,17 +172,17 @@ def join_bag(path: Path, say: Callable[[str], object] | None = None) -> tuple[in
     if len(files) > 1:
         if say is not None:
             say(f"joining {len(files)} segments ({info['message_count']} messages) …")
-        info = _join(path, topics, storage)
+        info = _join(path, files, topics, storage)
     return len(files), int(info["message_count"])
 
 
-def _join(path: Path, topics: dict[str, str], storage: str) -> dict[str, Any]:
-    """Write the bag ``path``'s messages into one storage file beside its segments, list it
-    in their place, remove them; the joined file's metadata."""
+def _join(path: Path, files: list[str], topics: dict[str, str], storage: str
+          ) -> dict[str, Any]:
+    """Write the bag ``path``'s messages into one storage file beside its segments (the
+    storage ``files`` it lists), list it in their place, remove them; the joined file's
+    metadata."""
     work = path / JOINING
     shutil.rmtree(work, ignore_errors=True)
-    listed = yaml.safe_load((path / "metadata.yaml").read_text())[META]["relative_file_paths"]
-    segments = [path / name for name in listed]
     with Reader(path) as reader, Writer(work / path.name, version=BAG_VERSION,
                                         storage_plugin=STORAGE[storage]) as writer:
         connections = {topic: writer.add_connection(topic, kind, typestore=TYPESTORE)
@@ -192,8 +193,8 @@ def _join(path: Path, topics: dict[str, str], storage: str) -> dict[str, Any]:
     name = info["relative_file_paths"][0]
     os.replace(writer.path / name, path / name)
     os.replace(writer.path / "metadata.yaml", path / "metadata.yaml")
-    for segment in segments:
-        if segment.name != name:
-            segment.unlink()
+    for segment in files:
+        if segment != name:
+            (path / segment).unlink()
     shutil.rmtree(work, ignore_errors=True)
     return info

@@ -287,8 +287,6 @@ def cmd_convert(args: argparse.Namespace) -> int:
     return 0
 
 
-
-
 def cmd_join(args: argparse.Namespace) -> int:
     from msg_tools.bag_segments import join_bag
 

@@ -332,9 +332,9 @@ class ValveLibrary(Library[Settled]):
 
 
 def _excess(valve: Settled, params: RigParameters) -> np.ndarray:
-    """The current beyond the dead-band e = I − I0 ≥ 0 [A], within the valve's range."""
-    current = np.minimum(valve.current_a, params.number(K.ACTUATOR_MAX_CURRENT_A))
-    return np.maximum(current - params.number(K.ACTUATOR_DEADBAND_CURRENT_A), 0.0)
+    """The map's variable e = I − I0 ≥ 0 [A] of the current the valve was fed."""
+    return el.valve_excess(valve.current_a, params.number(K.ACTUATOR_MAX_CURRENT_A),
+                           params.number(K.ACTUATOR_DEADBAND_CURRENT_A))
 
 
 VALVE = ValveLibrary()

@@ -269,13 +269,19 @@ def translational_mass(p):
 
 
 @njit(cache=True, inline="always")
+def valve_excess(current_a, max_current_a, deadband_a):
+    """The static map's variable e = I − I0 ≥ 0 [A], I within [0, I_max]."""
+    current = np.minimum(np.maximum(current_a, 0.0), max_current_a)
+    return np.maximum(current - deadband_a, 0.0)
+
+
+@njit(cache=True, inline="always")
 def valve_map(current_a, max_current_a, deadband_a, k1_pa_per_a, k2_pa_per_a2, k3_pa_per_a3,
               max_pressure_pa):
-    """Static current→pressure map P = k1 e + k2 e² + k3 e³, e = I − I0 ≥ 0, I within
-    [0, I_max], dead-band I0, saturation P_max [Pa]; k3 is the valve equation's generic
-    slot (0 on the reference rig)."""
-    current = np.minimum(np.maximum(current_a, 0.0), max_current_a)
-    excess = np.maximum(current - deadband_a, 0.0)
+    """Static current→pressure map P = k1 e + k2 e² + k3 e³ (:func:`valve_excess`),
+    dead-band I0, saturation P_max [Pa]; k3 is the valve equation's generic slot (0 on the
+    reference rig)."""
+    excess = valve_excess(current_a, max_current_a, deadband_a)
     pressure = (k1_pa_per_a * excess + k2_pa_per_a2 * excess * excess
                 + k3_pa_per_a3 * excess * excess * excess)
     return np.minimum(np.maximum(pressure, 0.0), max_pressure_pa)

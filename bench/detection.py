@@ -220,6 +220,17 @@ def independent_task(folder: str) -> dict:
             "errors": judged.errors, "seconds": round(time.perf_counter() - started, 1)}
 
 
+def unseen_task(folder: str, equation: str) -> dict:
+    """One campaign of an effect whose law no family or slot has (issue 41): right when it
+    is discovered in its equation; how it ended otherwise."""
+    started = time.perf_counter()
+    result = diagnose(read_runs([Path(folder)]).runs, load_parameters())
+    ok, outcome = independent.judge_unseen(result.to_json(), equation)
+    return {"cause": f"{equation} ({Path(folder).name})", "seed": Path(folder).name,
+            "ok": ok, "verdict": outcome[:30], "outcome": outcome, "error": None,
+            "seconds": round(time.perf_counter() - started, 1)}
+
+
 def _line(row: dict) -> str:
     error = math.nan if row["error"] is None else row["error"]
     return (f"{row['cause']:40s} {row['seed']:>24s} {row['verdict']:30s} {error:10.3g} "
@@ -307,7 +318,11 @@ def main() -> None:
     parser.add_argument("--independent", type=Path, default=independent.FOLDER,
                         help="campaigns with a truth.json (default: ../shared/data/"
                              "independent; skipped when absent)")
-    parser.add_argument("--only-independent", action="store_true")
+    parser.add_argument("--unseen", type=Path, default=independent.UNSEEN,
+                        help="campaigns of effects no family or slot has (default: ../shared/"
+                             "data/unseen; skipped when absent)")
+    parser.add_argument("--only-independent", action="store_true",
+                        help="only the campaigns the project did not make")
     args = parser.parse_args()
     plan = [(c, args.seed + 17 * i + j) for i, c in enumerate(args.causes.split(","))
             for j in range(args.per_cause)]
@@ -319,13 +334,21 @@ def main() -> None:
                 (cause, seed, args.light_runs, args.logger_realities)) for cause, seed in plan]
     theirs = [Task(f"independent-{folder.name}", independent_task, (str(folder),))
               for folder in independent.campaigns(args.independent)]
+    unseen = [Task(f"unseen-{folder.name}", unseen_task, (str(folder), equation))
+              for folder in independent.campaigns(args.unseen)
+              if (equation := independent.unseen_equation(folder)) is not None]
     if not theirs:
         print(f"{args.independent}: no independent campaigns, skipped", file=sys.stderr)
     journal = args.journal or Path("out/detection") / f"seed-{args.seed}{suffix}.jsonl"
     with client(args.scheduler, args.workers) as engine:
-        results = run_tasks([*theirs, *own], journal, engine,
+        results = run_tasks([*unseen, *theirs, *own], journal, engine,
                             lambda m: print(m, file=sys.stderr, flush=True))
-    for title, tasks in (("own generator", own), ("independent simulator", theirs)):
+    for row in (results[t.key] for t in unseen if t.key in results):
+        print(f"unseen {row['cause']:40s} {'yes' if row['ok'] else 'NO':>4s}  "
+              f"{row['outcome']}  ({row['seconds']:.0f} s)")
+    for title, tasks in (("own generator", own), ("independent simulator", theirs),
+                         ("unseen effects (issue 41: discovered in the right equation)",
+                          unseen)):
         rows = [results[t.key] for t in tasks if t.key in results]
         if rows:
             report(title, rows)

@@ -110,3 +110,31 @@ def judge(result: dict, want: Expected) -> Judgement:
         errors[f"{key.cause}.{key.name}"] = key.error(value)
         ok = ok and key.error(value) <= key.tolerance
     return Judgement(ok, label, errors)
+
+
+UNSEEN = FOLDER.parent / "unseen"
+"""Effects whose laws no family or slot of the project has (``../shared/data/unseen``)."""
+
+
+def unseen_equation(campaign: Path) -> str | None:
+    """The equation (as a finding names it) where the unseen effect of ``campaign`` lives;
+    None for a campaign that is not an effect in an equation (another rig, a datasheet)."""
+    truth = json.loads((campaign / "truth.json").read_text(encoding="utf-8"))
+    where = truth["effect"]["equation"]
+    if where.startswith("wheel (the tyre"):
+        return "tyre"
+    return where if where in ("valve", "wheel", "loading device", "F_x channel") else None
+
+
+def judge_unseen(result: dict, equation: str) -> tuple[bool, str]:
+    """Whether a diagnosis (its JSON) found the unseen effect in ``equation`` as a
+    discovered term (right), and how it ended, in words."""
+    findings = result["findings"]
+    first = findings[0] if findings else {}
+    if result["verdict"] == "discovered" and first.get("family") == equation:
+        return True, f"discovered {equation}: {first.get('term', '')}"
+    if any(f["cause"] == "unexplained" and f.get("equation") == equation for f in findings):
+        return False, f"unexplained, naming the {equation}"
+    if result["verdict"] == "discovered":
+        return False, f"discovered in the {first.get('family')}: {first.get('term', '')}"
+    return False, result["verdict"]

@@ -91,10 +91,11 @@ def test_each_equation_finds_its_own_hidden_term_and_no_other(reference, tmp_pat
     drawn = hidden.draw(np.random.default_rng(sum(map(ord, case))), reference)
     runs, calibrated = _campaign(reference, tmp_path, 310, drawn)
     campaign = eq.Campaign(runs, [br.prepare(r, calibrated) for r in runs if r.braking])
-    found = {library.equation: {s.term.key: s.value
+    found = {library.equation: {s.term.name: s.value
                                 for s in library.select(campaign, calibrated)}
              for library in eq.LIBRARIES}
-    assert found.pop(family.library.equation) == pytest.approx(drawn, rel=0.1)
+    assert found.pop(family.library.equation) == pytest.approx(
+        {hidden.key: drawn[hidden.slot]}, rel=hidden.tolerance)
     assert not any(found.values()), found
 
 
@@ -103,9 +104,9 @@ def test_a_clean_campaign_violates_no_equation_and_says_so(reference, tmp_path):
 
     runs, calibrated = _campaign(reference, tmp_path, 320)
     checks = [c for c in check_campaign(runs, calibrated)
-              if c.relation in (Relation.VALVE_MAP, Relation.WHEEL_BALANCE,
+              if c.relation in (Relation.VALVE_MAP, Relation.WHEEL_BALANCE, Relation.TYRE_LAW,
                                 Relation.FLYWHEEL_BALANCE, Relation.LOADING_LAW)]
-    assert len(checks) == 4
+    assert len(checks) == 5
     assert not [c.describe() for c in checks if c.violated]
 
 

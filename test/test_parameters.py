@@ -11,11 +11,11 @@ import yaml
 
 from landing_gear_sim.errors import ParameterError
 from landing_gear_sim.model import keys as K
+from landing_gear_sim.model.bundled import default_config_dir
 from landing_gear_sim.model.parameters import (
     INDEX,
     N_PARAMS,
     SPECS,
-    default_config_dir,
     load_parameters,
     parse_assignment,
 )
@@ -156,7 +156,7 @@ def test_every_spec_has_a_unit_and_description():
 
 def test_a_params_file_written_before_the_gain_slopes_and_crosstalk_still_loads(tmp_path):
     """Keys added to the schema later default to 'no such term' in older files."""
-    from landing_gear_sim.model.parameters import default_config_files
+    from landing_gear_sim.model.bundled import default_config_files
 
     text = default_config_files()[0].read_text()
     later = ("gain_slope", "crosstalk", "wheel_speed_delay")
@@ -179,8 +179,11 @@ def test_set_reads_an_exponent_without_a_dot_as_ros_does():
 
 
 def test_every_schema_key_is_a_constant_of_the_keys_module_in_the_schemas_order():
-    constants = [(name, value) for name, value in vars(K).items() if name.isupper()]
-    assert [value for _, value in constants] == [spec.key for spec in SPECS]
+    constants = [(name, value) for name, value in vars(K).items()
+                 if name.isupper() and isinstance(value, str)]
+    slots = [key for name, value in vars(K).items() if name.endswith("_TERMS")
+             for pair in value for key in pair]
+    assert [value for _, value in constants] + slots == [spec.key for spec in SPECS]
     assert all(name == value.replace(".", "_").upper() for name, value in constants)
 
 

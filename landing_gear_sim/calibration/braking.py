@@ -14,6 +14,7 @@ import scipy.signal
 from scipy.optimize import least_squares
 
 from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.calibration.slots import Slot, signals
 from landing_gear_sim.calibration.statistics import (
     Estimate,
     covariance_std,
@@ -171,14 +172,29 @@ def _sample_weights(per_run: Sequence[np.ndarray]) -> np.ndarray:
 
 
 def torque_balance(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
-    """Brake torque r F_x − J_w ω̇ − T_extra(ω) [N m] (T_extra: the wheel's generic slot of
-    ``p``, 0 unless a diagnosis found one) and the energy the brake absorbed, ∫ T_b ω dt [J]."""
+    """Brake torque r F_x − J_w ω̇ − T_extra [N m] (T_extra: the wheel's slots of ``p``, 0
+    unless a diagnosis found a term) and the energy the brake absorbed, ∫ T_b ω dt [J]."""
     torque = rolling_radius_at(p, b.load) * b.force - p.number(K.WHEEL_INERTIA_KG_M2) \
         * b.wheel_rate - wheel_extra_torque(p.vector(), b.wheel)
+    energy = _absorbed(b, torque)
+    if Slot.WHEEL.occupied(p):  # a term may read the energy: taken from the torque without it
+        torque = torque - Slot.WHEEL.value_of(p, measured_signals(b, p, energy))
+        energy = _absorbed(b, torque)
+    return torque, energy
+
+
+def _absorbed(b: Braking, torque: np.ndarray) -> np.ndarray:
+    """The energy a brake of ``torque`` absorbed since just before it acts [J]."""
     dt = np.diff(b.time_s, prepend=b.time_s[0])
     power = np.where(b.time_s > b.start_s - 0.1, np.clip(torque, 0, None), 0.0) \
         * np.clip(b.wheel, 0, None)
-    return torque, np.cumsum(power * dt)
+    return np.cumsum(power * dt)
+
+
+def measured_signals(b: Braking, p: RigParameters, energy: np.ndarray) -> np.ndarray:
+    """The signals of the equations' slots (:func:`~.slots.signals`) from ``b``'s filtered
+    ones and the brake's absorbed ``energy``."""
+    return signals(b.time_s, b.wheel, b.speed_m_s, b.pressure, b.load, energy, p)
 
 
 def model_torque(b: Braking, p: RigParameters, energy: np.ndarray, mask: np.ndarray

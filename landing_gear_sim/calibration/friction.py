@@ -12,12 +12,14 @@ from scipy.optimize import least_squares
 from landing_gear_sim.calibration.braking import LOADED_N, Braking, hub_speed
 from landing_gear_sim.calibration.measured import simulate_all
 from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
+from landing_gear_sim.calibration.slots import Slot
 from landing_gear_sim.calibration.statistics import Estimate, covariance_std, run_weights
 from landing_gear_sim.errors import IdentificationError
+from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.elements import burckhardt_mu, slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.model.quantities import load_factor_at, rolling_radius_at
+from landing_gear_sim.model.quantities import friction_at, load_factor_at, rolling_radius_at
 from msg_tools.run import Run
 
 KEYS = (K.FRICTION_THETA1, K.FRICTION_THETA2, K.FRICTION_THETA3)
@@ -44,8 +46,24 @@ def _run_samples(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
 def samples_at(b: Braking, p: RigParameters, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(slip, μ) of ``b`` at the samples ``idx`` (μ of the curve: the load factor taken off)."""
     load = b.load[idx]
-    mu = b.force[idx] / (load * load_factor_at(p, load))
-    return slip_ratio(hub_speed(b, p)[idx], b.wheel[idx], rolling_radius_at(p, load)), mu
+    slip = slip_ratio(hub_speed(b, p)[idx], b.wheel[idx], rolling_radius_at(p, load))
+    mu = b.force[idx] / load
+    if Slot.TYRE.occupied(p):  # the tyre's slot is known, like the load factor
+        mu = mu - Slot.TYRE.value_of(p, tyre_signals(b, p, idx))
+    return slip, mu / load_factor_at(p, load)
+
+
+def tyre_signals(b: Braking, p: RigParameters, idx: np.ndarray) -> np.ndarray:
+    """The tyre slot's signals at the samples ``idx`` of ``b``: its speed, load, slip (at
+    the hub) and the model's curve there, as the plant gives them."""
+    load = b.load[idx]
+    measured = np.zeros((idx.size, basis.N_SIGNALS))
+    measured[:, basis.SPEED] = b.speed_m_s[idx]
+    measured[:, basis.LOAD] = load
+    measured[:, basis.SLIP] = np.abs(slip_ratio(hub_speed(b, p)[idx], b.wheel[idx],
+                                                rolling_radius_at(p, load)))
+    measured[:, basis.CURVE] = friction_at(p, measured[:, basis.SLIP])
+    return measured
 
 
 def friction_indices(b: Braking, p: RigParameters) -> np.ndarray:

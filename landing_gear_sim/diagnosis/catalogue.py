@@ -72,6 +72,8 @@ class Candidate:
             cause.
         neutral: values of ``keys`` at which the extended model is the model without it
             (a term at zero); empty: no such point within the bounds.
+        settings: parameters set, not fitted, in every model it is fitted from (a generic
+            slot's basis function codes: at a coefficient of zero they change nothing).
     """
 
     cause: str
@@ -87,6 +89,7 @@ class Candidate:
     reach: Reach | None = None
     family: str = ""
     neutral: tuple[float, ...] = ()
+    settings: tuple[tuple[str, float], ...] = ()
 
 
 Reach = Callable[[dict[str, float], Sequence[ClassifiedRun], RigParameters], str]

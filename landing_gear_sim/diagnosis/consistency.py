@@ -35,6 +35,7 @@ import numpy as np
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.plausibility import counted_wheel_step
 from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.calibration.slots import Slot
 from landing_gear_sim.calibration.statistics import (
     inverse_variance_weights,
     linear_std,
@@ -244,6 +245,9 @@ def free_rolling_excess(b: br.Braking, params: RigParameters) -> tuple[np.ndarra
     radius = rolling_radius_at(params, b.load[m])
     torque = (params.number(K.WHEEL_INERTIA_KG_M2) * b.wheel_rate[m]
               + el.wheel_extra_torque(params.vector(), b.wheel[m]))
+    if Slot.WHEEL.occupied(params):
+        _, energy = br.torque_balance(b, params)
+        torque = torque + Slot.WHEEL.value_of(params, br.measured_signals(b, params, energy))[m]
     force = SensorModel.of(params).true_longitudinal(b.run.longitudinal_force_n[m],
                                                      b.run.vertical_load_n[m])
     return m, force - torque / radius

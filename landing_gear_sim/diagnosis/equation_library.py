@@ -1,19 +1,18 @@
-"""Each equation's library of terms, and its error regressed on it (issue 29).
+"""Each equation of the rig with its library of terms, and its error (issues 29, 41).
 
 Every effect, catalogued or not, is a missing term in one of the rig's equations. For the
-valve's static map, the wheel's torque balance, the flywheel's momentum balance and the
-loading device's law, the error is computed from the measured signals under the model (the
-other equations' terms measured) over the samples that carry it: the actuator runs' settled
-ones for the valve, every braking run's thinned to the filter's bandwidth for the others.
-It is regressed on the equation's library — the terms of its generic slot in the plant
-(``actuator.extra_*``, ``wheel.extra_*``, ``flywheel.extra_*``, ``loading.extra_*``),
-beside the terms whose coefficients the calibration owns (the map's 1, e, e²; k_b P in the
-wheel's; the flywheel's mass and drag; the lift) — by a sparse solver (scikit-learn's LARS
-lasso, BIC). A term the lasso keeps is significant when an ordinary fit of the kept and owned
-terms finds it against the error's own noise (t over the error's effective count, above
-:data:`Z_VIOLATED`) and large enough to matter (:data:`MIN_EFFECT` of the equation's scale):
-the equation's relation (:class:`~.relations.Relation`) is then violated, and the equation's
-family (:mod:`~.families.equation_terms`) proposes the term.
+valve's static map, the wheel's torque balance, the tyre's force law, the flywheel's
+momentum balance and the loading device's law, the error is computed from the measured
+signals under the model (the other equations' terms measured) over the samples that carry
+it: the actuator runs' settled ones for the valve, every braking run's thinned to the
+filter's bandwidth for the others. Each equation's library is the terms of its slot in the
+plant — the generic slots' basis functions composed with :mod:`~.terms`
+(``wheel.term_*``, ``friction.term_*``, ``loading.term_*``), the named ones' terms
+(``actuator.extra_*``, ``flywheel.extra_*``) — beside the terms whose coefficients the
+calibration owns (the map's 1, e, e²; k_b P in the wheel's; the curve's ϑ; the flywheel's
+mass and drag; the lift). :mod:`~.selection` picks the terms the error needs; the equation's
+relation (:class:`~.relations.Relation`) is then violated, and the equation's family
+(:mod:`~.families.equation_terms`) proposes them.
 """
 
 from __future__ import annotations
@@ -26,58 +25,38 @@ from typing import Any, Generic, TypeVar
 import numpy as np
 
 from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration import friction
 from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.calibration.slots import Slot, seen
+from landing_gear_sim.diagnosis.catalogue import noise_std
 from landing_gear_sim.diagnosis.equations import Equation
-from landing_gear_sim.diagnosis.relations import Z_VIOLATED, Check, Relation
-from landing_gear_sim.diagnosis.scoring import effective_count
+from landing_gear_sim.diagnosis.relations import Check, Relation
+from landing_gear_sim.diagnosis.selection import (
+    Rows,
+    Selected,
+    Term,
+    basis_terms,
+    fit_terms,
+    floor_of,
+    ordinary_fit,
+    significant,
+    term_columns,
+    variable,
+)
 from landing_gear_sim.diagnosis.settled_valve import Settled, settled_valve
-from landing_gear_sim.diagnosis.sparse import sparse_coefficients
+from landing_gear_sim.diagnosis.terms import Shaped, Without
+from landing_gear_sim.model import basis
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.quantities import friction_coefficients, load_factor_at
 from msg_tools.units import display
 
-MIN_EFFECT = 0.005  # a term's rms effect over the equation's scale: half a per cent
 EDGE_S = 0.5  # the zero-phase filter's ends are left out
 SETTLE_S = 0.5  # after the touch-down ramp, before the loading device's load is its law
 VALVE_RATE_HZ = 100.0  # a valve's settled samples are thinned to this: closer ones add little
 
 S = TypeVar("S")  # what a library reads one run's rows from: a braking run's signals, ...
-
-
-@dataclass(frozen=True)
-class Term(Generic[S]):
-    """A term of an equation's generic slot: its key (the coefficient), how it is written
-    in the law (``symbol``, '' for a constant), the coefficient's SI unit and admissible
-    magnitude, and its variable as the term enters the equation's error (coefficient 1),
-    from what the library reads a run from and the model."""
-
-    key: str
-    symbol: str
-    unit: str
-    bound: float
-    values: Callable[[S, RigParameters], np.ndarray]
-
-
-@dataclass(frozen=True)
-class Rows:
-    """One run's regression rows: the equation's error, its library's terms (m, k), the
-    terms the calibration owns (m, j), and the equation's scale [its unit]."""
-
-    error: np.ndarray
-    terms: np.ndarray
-    owned: np.ndarray
-    scale: float
-
-
-@dataclass(frozen=True)
-class Selected:
-    """A term the equation's error needs: its fitted value, its t and its rms effect."""
-
-    term: Term
-    value: float
-    t: float
-    effect: float
 
 
 @dataclass(frozen=True)
@@ -101,6 +80,7 @@ class Library(abc.ABC, Generic[S]):
     unit: str
     phase: str
     sign: float = -1.0
+    slot: Slot | None = None  # the generic slot its basis terms take places in
 
     @abc.abstractmethod
     def sources(self, campaign: Campaign, params: RigParameters) -> list[S]:
@@ -119,19 +99,20 @@ class Library(abc.ABC, Generic[S]):
     def select(self, campaign: Campaign, params: RigParameters) -> list[Selected]:
         """The library's terms the equation's error needs under ``params``."""
         rows = self._rows(campaign, params)
-        return [s for s in _fit(self.terms, rows) if _significant(s, rows)] if rows else []
+        fitted = fit_terms(self.terms, rows) if rows else None
+        return fitted.selected if fitted and significant(fitted, rows) else []
 
     def check(self, campaign: Campaign, params: RigParameters) -> Check | None:
-        """The equation's relation over the campaign: its strongest term (None: no run to
-        tell)."""
+        """The equation's relation over the campaign: what its terms explain jointly (None:
+        no run to tell)."""
         rows = self._rows(campaign, params)
-        fitted = _fit(self.terms, rows) if rows else []
-        if not fitted:
+        fitted = fit_terms(self.terms, rows) if rows else None
+        if fitted is None or not fitted.selected:
             return None
-        strongest = max(fitted, key=lambda s: s.t)
-        floor = MIN_EFFECT * _scale(rows)
-        return Check(self.relation, "campaign", f"{self.phase}, {strongest.term.key}",
-                     strongest.effect, strongest.effect / strongest.t, floor, self.unit)
+        named = ", ".join(s.term.name for s in fitted.selected)
+        return Check(self.relation, "campaign", f"{self.phase}, {named}", fitted.effect,
+                     fitted.effect / max(fitted.z, 1e-12), floor_of(rows),
+                     self.unit)
 
     def _rows(self, campaign: Campaign, params: RigParameters) -> list[Rows]:
         return [r for s in self.sources(campaign, params)
@@ -146,39 +127,6 @@ class BrakingLibrary(Library[br.Braking]):
     def sources(self, campaign: Campaign, params: RigParameters) -> list[br.Braking]:
         return list(campaign.braking)
 
-
-def _fit(terms: Sequence[Term[Any]], rows: Sequence[Rows]) -> list[Selected]:
-    """The terms the lasso keeps among ``terms`` and the owned ones (all of ``terms`` when it
-    keeps none: the relation is checked all the same), each with its ordinary fit beside the
-    owned terms."""
-    y = np.concatenate([r.error for r in rows])
-    x, owned = np.vstack([r.terms for r in rows]), np.vstack([r.owned for r in rows])
-    if y.size < 10 * (x.shape[1] + owned.shape[1]):
-        return []
-    lasso = sparse_coefficients(np.hstack([x, owned]), y, intercept=False)
-    kept = [int(i) for i in np.flatnonzero(lasso[:len(terms)])] or list(range(len(terms)))
-    coef, t = ordinary_fit(np.hstack([x[:, kept], owned]), y)
-    return [Selected(terms[column], float(coef[i]), float(t[i]),
-                     abs(float(coef[i])) * float(np.sqrt(np.mean(x[:, column] ** 2))))
-            for i, column in enumerate(kept)]
-
-
-def _significant(selected: Selected, rows: Sequence[Rows]) -> bool:
-    return selected.t > Z_VIOLATED and selected.effect > MIN_EFFECT * _scale(rows)
-
-
-def _scale(rows: Sequence[Rows]) -> float:
-    return float(np.mean([r.scale for r in rows]))
-
-
-def ordinary_fit(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """y ≈ x c by least squares: c and |c| over its standard error, the residual's
-    variance taken over its effective count (an equation's error is not white)."""
-    coef, *_ = np.linalg.lstsq(x, y, rcond=None)
-    residual = y - x @ coef
-    variance = float(residual @ residual) / effective_count(residual)
-    std = np.sqrt(np.diag(np.linalg.pinv(x.T @ x)) * variance)
-    return coef, np.abs(coef) / std
 
 
 def _thinned(mask: np.ndarray, rate_hz: float) -> np.ndarray:
@@ -198,18 +146,29 @@ def _about_run_mean(error: np.ndarray, terms: np.ndarray, owned: np.ndarray, sca
                 scale)
 
 
+WHEEL_TERMS = (
+    Shaped((basis.OMEGA,), (basis.SIGN, basis.IDENTITY, basis.SIGNED_SQUARE, basis.SIGNED_ROOT))
+    + Shaped((basis.SPEED, basis.LOAD, basis.SLIP),
+             (basis.IDENTITY, basis.SIGNED_SQUARE, basis.SIGNED_ROOT))
+    + Shaped((basis.PRESSURE,), (basis.STEP, basis.SIGNED_SQUARE, basis.SIGNED_ROOT))
+    + Shaped((basis.BRAKE_ENERGY,), (basis.STEP, basis.IDENTITY, basis.SIGNED_ROOT))
+    + Shaped((basis.OMEGA,), (basis.SIGN,)) * Shaped((basis.PRESSURE,), (basis.STEP,)))
+"""The wheel's library: its speeds, load and slip in the shapes a bearing, a seal, a
+windage or a tyre's rolling loss take; whether the brake is applied and has been; the
+pressure beyond linear (k_b P is the calibration's own)."""
+
+
 class WheelLibrary(BrakingLibrary):
-    """The wheel's torque balance J_w ω̇ = r F_x − T_b − T₀ sgn ω − T₁ ω: a bearing's
-    friction, a released brake that drags, a seal. Its error is measured where the brake
-    holds steadily and, with no brake at all, in the free rolling before it."""
+    """The wheel's torque balance J_w ω̇ = r F_x − T_b − Σ c_k φ_k: a bearing's friction, a
+    released brake that drags, a seal, pads that drag once applied. Its error is measured
+    where the brake holds steadily and, with no brake at all, in the free rolling before
+    it."""
 
     equation = Equation.WHEEL
     relation = Relation.WHEEL_BALANCE
     unit = "N m"
-    terms = (
-        Term(K.WHEEL_EXTRA_TORQUE_N_M, "", "N m", 2000.0, lambda b, _: np.sign(b.wheel)),
-        Term(K.WHEEL_EXTRA_TORQUE_N_M_S_PER_RAD, "·ω", "N m s/rad", 20.0, lambda b, _: b.wheel),
-    )
+    slot = Slot.WHEEL
+    terms = basis_terms(WHEEL_TERMS, "N m")
 
     def rows(self, b: br.Braking, params: RigParameters,
              terms: Sequence[Term[br.Braking]] | None = None) -> Rows | None:
@@ -218,8 +177,9 @@ class WheelLibrary(BrakingLibrary):
             return None
         torque, energy = br.torque_balance(b, params)
         model = br.model_torque(b, params, energy, index)
+        measured = seen(Slot.WHEEL, br.measured_signals(b, params, energy)[index])
         return Rows(torque[index] - model,
-                    np.column_stack([t.values(b, params)[index] for t in terms or self.terms]),
+                    term_columns(terms or self.terms, b, params, index, measured),
                     model[:, None], float(np.mean(np.abs(model))))
 
     def law(self, written: str, params: RigParameters) -> str:
@@ -251,7 +211,7 @@ class FlywheelLibrary(BrakingLibrary):
         speed = b.speed_m_s
         resisting = b.force + el.drag_forces(p, speed) + el.flywheel_extra_force(p, speed)
         impulse = np.cumsum(resisting * dt)
-        columns = [np.cumsum(t.values(b, params) * dt) for t in terms or self.terms]
+        columns = [np.cumsum(variable(t, b, params) * dt) for t in terms or self.terms]
         owned = [speed, np.cumsum(speed * speed * dt)]
         return _about_run_mean((el.translational_mass(p) * speed + impulse)[index],
                                np.column_stack(columns)[index], np.column_stack(owned)[index],
@@ -261,16 +221,27 @@ class FlywheelLibrary(BrakingLibrary):
         return f"m_f·v̇ = −F_x − α_d·v² {written}"
 
 
+LOADING_TERMS = Without(
+    Shaped((basis.SPEED, basis.CONTACT_TIME),
+           (basis.IDENTITY, basis.SIGNED_SQUARE, basis.CUBE, basis.SIGNED_ROOT))
+    + Shaped((basis.SPEED,), (basis.IDENTITY,)) * Shaped((basis.CONTACT_TIME,),
+                                                          (basis.IDENTITY,)),
+    frozenset({basis.factor_code(basis.SPEED, basis.SIGNED_SQUARE)}))
+"""The loading device's library: the speed and the time since contact in powers (a
+cylinder that leaks, a servo that sags, a lift law of another form); k_L v² is the
+calibration's own."""
+
+
 class LoadingLibrary(BrakingLibrary):
-    """The loading device's set point F_z0 − k_L v² − c v: a load that sags with speed
-    beside the lift law. Its error is measured once the load has settled, about each run's
-    own static load."""
+    """The loading device's set point F_z0 − k_L v² − Σ c_k φ_k(v, t_c): a load that sags
+    with speed beside the lift law, a cylinder that leaks. Its error is measured once the
+    load has settled, about each run's own static load."""
 
     equation = Equation.LOADING
     relation = Relation.LOADING_LAW
     unit = "N"
-    terms = (Term(K.LOADING_EXTRA_LOAD_N_S_PER_M, "·v", "N s/m", 500.0,
-                  lambda b, _: -b.speed_m_s),)
+    slot = Slot.LOADING
+    terms = basis_terms(LOADING_TERMS, "N")
 
     def rows(self, b: br.Braking, params: RigParameters,
              terms: Sequence[Term[br.Braking]] | None = None) -> Rows | None:
@@ -283,14 +254,77 @@ class LoadingLibrary(BrakingLibrary):
         if index.size < 20:
             return None
         speed = b.speed_m_s[index]
-        columns = [t.values(b, params)[index] for t in terms or self.terms]
-        return _about_run_mean(b.load[index] + el.load_lift(params.vector(), speed),
-                               np.column_stack(columns),
+        measured = seen(Slot.LOADING, br.measured_signals(b, params, np.zeros(b.time_s.size))
+                        [index])
+        taken = el.load_lift(params.vector(), speed) + Slot.LOADING.value_of(params, measured)
+        # the set point the servo was following: the load led by its lag (a set point that
+        # falls with v² is followed τ late, 120 N at 60 m/s braking at 8 m/s²)
+        tau = params.number(K.LOADING_SERVO_TIME_CONSTANT_S)
+        setpoint = b.load + tau * np.gradient(b.load, b.time_s)
+        return _about_run_mean(setpoint[index] + taken,
+                               -term_columns(terms or self.terms, b, params, index, measured),
                                (speed * speed)[:, None], float(np.mean(b.load[index])))
 
     def law(self, written: str, params: RigParameters) -> str:
         lift = display(params.number(K.LOADING_LIFT_COEFF_N_S2_PER_M2), "N s^2/m^2", ".3g")
         return f"F_z = F_z0 − {lift}·v² {written}"
+
+
+TYRE_TERMS = (Shaped((basis.CURVE,), (basis.SQUARE, basis.CUBE))
+              + Shaped((basis.CURVE,), (basis.IDENTITY,))
+              * Shaped((basis.SPEED, basis.SLIP), (basis.IDENTITY, basis.SIGNED_ROOT)))
+"""The tyre's library: the calibrated curve μ_B in the powers another curve's shape takes
+(a magic formula's peak), and scaled by the speed (a friction that falls with the sliding
+speed) or the slip (beyond the peak): every term bounded over the slips, 0 where the curve
+is (at zero slip a rolling tyre pushes nothing: λ² once gave a locked wheel 0.8 more μ), and
+of a finite slope there (the plant's step is sized by the curve's steepest slope). μ_B alone
+and its ϑ are the calibration's own, the load the ``load`` family's (within a stop the load
+follows the speed: terms in both read alike, and a clean campaign's slip noise filled
+them)."""
+
+
+class TyreLibrary(BrakingLibrary):
+    """The tyre's force law F_x = F_z (μ_B(λ) g(F_z) + Σ c_k φ_k(λ, v, F_z)): a friction
+    curve of another shape, a friction that changes with speed within a stop. Its error is
+    μ = F_x / F_z less the model's over the braking samples the calibration fits its curve
+    on; the curve's ϑ are owned (their derivatives: the curve may bend)."""
+
+    equation = Equation.TYRE
+    relation = Relation.TYRE_LAW
+    unit = "-"
+    slot = Slot.TYRE
+    sign = 1.0
+    terms = basis_terms(TYRE_TERMS, "-")
+
+    def rows(self, b: br.Braking, params: RigParameters,
+             terms: Sequence[Term[br.Braking]] | None = None) -> Rows | None:
+        index = friction.friction_indices(b, params)
+        if index.size < 20:
+            return None
+        slip, curve_mu = friction.samples_at(b, params, index)
+        factor = load_factor_at(params, b.load[index])
+        t1, t2, t3 = friction_coefficients(params)
+        model = el.burckhardt_mu(t1, t2, t3, slip)
+        decay = np.exp(-t2 * slip)
+        owned = np.column_stack([1.0 - decay, t1 * slip * decay, -slip]) * factor[:, None]
+        measured = seen(Slot.TYRE, friction.tyre_signals(b, params, index))
+        slope = t1 * t2 * decay - t3
+        return Rows((curve_mu - model) * factor,
+                    term_columns(terms or self.terms, b, params, index, measured),
+                    owned, float(np.mean(np.abs(model * factor))),
+                    float(np.sqrt(np.mean((slope * factor * _slip_noise(b, index)) ** 2))))
+
+    def law(self, written: str, params: RigParameters) -> str:
+        return f"μ = μ_B(λ)·g(F_z) {written}"
+
+
+def _slip_noise(b: br.Braking, index: np.ndarray) -> np.ndarray:
+    """The 1-σ of the slip at the samples ``index`` that the wheel channel's noise leaves
+    through the calibration's low-pass: the channel's noise (first differences) over the
+    share of its band the filter passes, over the speed."""
+    raw = noise_std(b.run.wheel_speed_rad_s)
+    filtered = raw * np.sqrt(min(1.0, 2.0 * br.FILTER_HZ / (b.run.rate_hz / 2.0)))
+    return filtered / np.maximum(b.wheel[index], 1.0)
 
 
 class ValveLibrary(Library[Settled]):
@@ -321,7 +355,7 @@ class ValveLibrary(Library[Settled]):
         excess = _excess(source, params)[index]
         owned = gain * np.column_stack([np.ones_like(excess), excess, excess * excess])
         return Rows(source.residual_pa[index],
-                    gain * np.column_stack([t.values(source, params)[index]
+                    gain * np.column_stack([variable(t, source, params)[index]
                                             for t in terms or self.terms]),
                     owned, float(np.mean(source.model_pa[index])))
 
@@ -339,9 +373,10 @@ def _excess(valve: Settled, params: RigParameters) -> np.ndarray:
 
 VALVE = ValveLibrary()
 WHEEL = WheelLibrary()
+TYRE = TyreLibrary()
 FLYWHEEL = FlywheelLibrary()
 LOADING = LoadingLibrary()
-LIBRARIES: tuple[Library[Any], ...] = (VALVE, WHEEL, FLYWHEEL, LOADING)
+LIBRARIES: tuple[Library[Any], ...] = (VALVE, WHEEL, TYRE, FLYWHEEL, LOADING)
 
 
 def equation_checks(campaign: Campaign, params: RigParameters) -> list[Check]:

@@ -31,6 +31,7 @@ class Equation(str, enum.Enum):
 
     VALVE = "valve"
     WHEEL = "wheel"
+    TYRE = "tyre"
     FLYWHEEL = "flywheel"
     LOADING = "loading device"
 
@@ -42,6 +43,7 @@ class Equation(str, enum.Enum):
         """The equation, in words."""
         return {"valve": "P = A(s)·map(i) (valve pressure)",
                 "wheel": "J_w·ω̇ = r·F_x − T_b (wheel rotation)",
+                "tyre": "F_x = F_z·μ(λ) (tyre force)",
                 "flywheel": "m_f·v̇ = −F_x − F_drag (flywheel)",
                 "loading device": "F_z follows F_z0 − k_L·v² (loading device)"}[self.value]
 

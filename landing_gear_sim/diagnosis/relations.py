@@ -34,6 +34,7 @@ class Relation(str, enum.Enum):
     FLYWHEEL_BALANCE = "flywheel slowed by F_x and the drag alone"
     LOADING_LAW = "vertical load follows F_z0 − k_L v²"
     VALVE_MAP = "valve settles on its quadratic static map"
+    TYRE_LAW = "tyre follows its friction curve"
 
     def __str__(self) -> str:
         return self.value
@@ -65,6 +66,7 @@ _WHERE = {
     "FLYWHEEL_BALANCE": ("flywheel", "flywheel_speed_rad_s"),
     "LOADING_LAW": ("loading device", "vertical_load_n"),
     "VALVE_MAP": ("valve", "pressure_pa"),
+    "TYRE_LAW": ("tyre", "wheel_speed_rad_s"),
 }
 @dataclass(frozen=True)
 class Check:

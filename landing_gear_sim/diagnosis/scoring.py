@@ -126,6 +126,9 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
     it), its null's from ``model`` (the best the runs give without it)."""
     fit_runs, held_runs = split_runs(candidate, runs)
     sub = _as_fitting(candidate, fit_runs)
+    if candidate.settings:
+        model = model.replace(dict(candidate.settings), f"{candidate.family}'s terms")
+        start = start and start.replace(dict(candidate.settings), f"{candidate.family}'s terms")
     with_it = fit_candidate(sub, fit_runs, start or model, datasheet, scales=scales)
     without = fit_candidate(sub, fit_runs, model, datasheet, null=True, scales=scales)
     if candidate.neutral and with_it.cost > without.cost:

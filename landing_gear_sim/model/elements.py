@@ -18,6 +18,7 @@ import math
 import numpy as np
 from numba import njit
 
+from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import INDEX
 
@@ -85,6 +86,13 @@ FLY_EXTRA_0 = INDEX[K.FLYWHEEL_EXTRA_FORCE_N]
 FLY_EXTRA_1 = INDEX[K.FLYWHEEL_EXTRA_FORCE_N_S_PER_M]
 LOAD_EXTRA_1 = INDEX[K.LOADING_EXTRA_LOAD_N_S_PER_M]
 MAP_EXTRA_3 = INDEX[K.ACTUATOR_EXTRA_MAP_PA_PER_A3]
+WHEEL_SLOT = INDEX[K.WHEEL_TERMS[0][0]]
+TYRE_SLOT = INDEX[K.TYRE_TERMS[0][0]]
+LOADING_SLOT = INDEX[K.LOADING_TERMS[0][0]]
+# a slot's (code, coefficient) pairs are read as consecutive entries
+assert INDEX[K.WHEEL_TERMS[-1][1]] == WHEEL_SLOT + 2 * basis.SLOT_TERMS - 1
+assert INDEX[K.TYRE_TERMS[-1][1]] == TYRE_SLOT + 2 * basis.SLOT_TERMS - 1
+assert INDEX[K.LOADING_TERMS[-1][1]] == LOADING_SLOT + 2 * basis.SLOT_TERMS - 1
 
 
 @njit(cache=True, inline="always")
@@ -112,9 +120,18 @@ def tyre_friction(p, slip, speed_m_s, vertical_load_n):
     first = THETA1
     if p[CHANGE_SPEED] > 0.0 and speed_m_s < p[CHANGE_SPEED]:
         first = AFTER_THETA1
-    mu = burckhardt_mu(p[first], p[first + 1], p[first + 2], abs(slip)) * load_factor(
-        p, vertical_load_n)
+    curve = burckhardt_mu(p[first], p[first + 1], p[first + 2], abs(slip))
+    mu = curve * load_factor(p, vertical_load_n) + tyre_slot(p, slip, speed_m_s,
+                                                             vertical_load_n, curve)
     return mu if slip >= 0.0 else -mu
+
+
+@njit(cache=True, inline="always")
+def tyre_slot(p, slip, speed_m_s, vertical_load_n, curve):
+    """The tyre equation's generic slot (``model.basis``): Σ c_k φ_k(|λ|, v, F_z, μ_B)
+    added to μ, μ_B the curve at |λ| (0 on the reference rig)."""
+    return basis.slot_value(p, TYRE_SLOT, (0.0, speed_m_s, 0.0, vertical_load_n, abs(slip),
+                                           0.0, 0.0, 0.0, curve))
 
 
 @njit(cache=True)
@@ -239,10 +256,20 @@ def wheel_extra_torque(p, wheel_speed_rad_s):
 
 
 @njit(cache=True)
-def wheel_acceleration(p, wheel_speed_rad_s, radius_m, tyre_force_n, brake_torque_n_m):
-    """ω̇ from eq. (7) with the wheel's generic slot, and lock: a stopped wheel stays stopped
-    while the brake holds it."""
-    net = radius_m * tyre_force_n - brake_torque_n_m - wheel_extra_torque(p, wheel_speed_rad_s)
+def wheel_slot_torque(p, signals):
+    """The wheel equation's generic slot (``model.basis``): Σ c_k φ_k [N m] opposing the
+    rotation beside the brake's, at ``signals`` (ω, v, P, F_z, λ, E_b, θ, 0; 0 on the
+    reference rig)."""
+    return basis.slot_value(p, WHEEL_SLOT, signals)
+
+
+@njit(cache=True)
+def wheel_acceleration(p, wheel_speed_rad_s, radius_m, tyre_force_n, brake_torque_n_m,
+                       extra_torque_n_m):
+    """ω̇ from eq. (7) with the torque of the wheel's slots (``extra_torque_n_m``:
+    :func:`wheel_extra_torque` and :func:`wheel_slot_torque`), and lock: a stopped wheel
+    stays stopped while the brake holds it."""
+    net = radius_m * tyre_force_n - brake_torque_n_m - extra_torque_n_m
     if wheel_speed_rad_s <= 0.0 and net <= 0.0:
         return 0.0
     return net / p[WHEEL_INERTIA]
@@ -310,4 +337,13 @@ def vertical_load_reference(p, time_s, speed_m_s):
         return 0.0
     ramp = p[TOUCHDOWN_RAMP]
     scale = 1.0 if ramp <= 0.0 or elapsed >= ramp else elapsed / ramp
-    return scale * max(p[LOAD_STATIC] - load_lift(p, speed_m_s), 0.0)
+    return scale * max(p[LOAD_STATIC] - load_lift(p, speed_m_s)
+                       - loading_slot(p, speed_m_s, elapsed), 0.0)
+
+
+@njit(cache=True)
+def loading_slot(p, speed_m_s, contact_time_s):
+    """The loading equation's generic slot (``model.basis``): Σ c_k φ_k(v, t_c) [N] taken
+    off the set point, t_c the time since touch-down (0 on the reference rig)."""
+    return basis.slot_value(p, LOADING_SLOT, (0.0, speed_m_s, 0.0, 0.0, 0.0, 0.0, 0.0,
+                                              contact_time_s, 0.0))

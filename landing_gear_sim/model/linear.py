@@ -24,6 +24,7 @@ from landing_gear_sim.model.plant import (
     TYRE_FORCE,
     derivatives,
     tyre_state,
+    wheel_extra,
 )
 
 
@@ -81,8 +82,10 @@ def operating_point(params: RigParameters, speed_m_s: float, slip: float = 0.05)
     if params.has("gear_walk"):
         x[ANGLE] = params.number(K.GEAR_WALK_LENGTH_M) * force / params.number(
             K.GEAR_WALK_STIFFNESS_N_M_PER_RAD)
-    pressure = (radius * force - el.wheel_extra_torque(p, x[OMEGA])) / params.number(
-        K.BRAKE_GAIN_N_M_PER_PA)
+    gain = params.number(K.BRAKE_GAIN_N_M_PER_PA)
+    pressure = 0.0
+    for _ in range(2):  # a slot's term may read the pressure it balances
+        pressure = (radius * force - wheel_extra(p, x, pressure, load, slip)) / gain
     return OperatingPoint(speed_m_s, slip, load, pressure, x)
 
 

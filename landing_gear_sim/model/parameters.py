@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import difflib
 import math
-import os
-import sys
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -21,6 +19,7 @@ import yaml
 
 from landing_gear_sim.errors import ParameterError
 from landing_gear_sim.model import keys as K
+from landing_gear_sim.model.bundled import default_config_files
 
 if TYPE_CHECKING:
     import numpy as np
@@ -32,6 +31,7 @@ ELEMENTS: tuple[str, ...] = ("gear_walk", "load_dependent_radius", "actuator_dyn
 extensions the reference rig does not have (off in its file)."""
 
 CONFIGURATIONS: tuple[str, ...] = ("rig", "aircraft")
+CODE_LIMIT = 256 * 257  # a slot's codes: two factors of model.basis (checked there)
 
 
 @dataclass(frozen=True)
@@ -56,6 +56,18 @@ def _f(key: str, unit: str, description: str, positive: bool = True) -> ParamSpe
 def _slot(key: str, unit: str, description: str) -> ParamSpec:
     """A term of an equation's generic slot (issue 29): either sign, 0 when a file lacks it."""
     return ParamSpec(key, unit, f"{description} (0: none)", signed=True, default=0.0)
+
+
+def _slot_terms(keys: tuple[tuple[str, str], ...], unit: str, law: str
+                ) -> tuple[ParamSpec, ...]:
+    """An equation's generic slot (issue 41, ``model.basis``): per term the code of its basis
+    function (a whole number) and its coefficient, in the equation's unit per the basis
+    function's."""
+    return tuple(spec for code, coeff in keys for spec in (
+        ParamSpec(code, "-", f"code of a basis function phi_k of {law} (model.basis: one or "
+                  "two factors, each a signal through a shape)", default=0.0),
+        ParamSpec(coeff, f"{unit} per phi", f"coefficient c_k of {law} (0: none)",
+                  signed=True, default=0.0)))
 
 
 def _ripple(prefix: str, law: str, cause: str, read_from: str) -> tuple[ParamSpec, ...]:
@@ -188,6 +200,12 @@ SPECS: tuple[ParamSpec, ...] = (
           "the speed beside the lift law: F_z0 - k_L v^2 - c v"),
     _slot(K.ACTUATOR_EXTRA_MAP_PA_PER_A3, "Pa/A^3", "static map term k3 (I - I0)^3 beside "
           "k1, k2 (a map that bends: flow forces, a spring's progression)"),
+    *_slot_terms(K.WHEEL_TERMS, "N m", "the wheel's torque balance: J_w dw/dt = r F_x - T_b - "
+                 "sum c_k phi_k"),
+    *_slot_terms(K.TYRE_TERMS, "-", "the tyre's friction law: mu = mu_B(slip) (load factor) "
+                 "+ sum c_k phi_k"),
+    *_slot_terms(K.LOADING_TERMS, "N", "the loading device's set point: F_z0 - k_L v^2 - "
+                 "sum c_k phi_k"),
 )
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}
@@ -196,36 +214,6 @@ _SPEC_BY_KEY: dict[str, ParamSpec] = {spec.key: spec for spec in SPECS}
 _OWNED_SECTIONS: frozenset[str] = frozenset(key.split(".")[0] for key in INDEX)
 
 Value = float | bool | str
-
-
-def default_config_dir() -> Path:
-    """The bundled ``config/`` folder: source tree, then the install prefix's ``share/``."""
-    package = Path(__file__).resolve().parents[1]  # landing_gear_sim/
-    share = Path("share") / "landing_gear_sim" / "config"
-    # source tree, this copy's prefix (<prefix>/lib/pythonX.Y/site-packages/…), ROS, venv
-    own_prefix = [package.parents[3] / share] if len(package.parents) > 3 else []
-    candidates = [
-        package.parent / "config",
-        *own_prefix,
-        *(Path(p) / share for p in _ament_prefixes()),
-        Path(sys.prefix) / share,
-    ]
-    for candidate in candidates:
-        if (candidate / "reference_rig.yaml").is_file():
-            return candidate
-    raise ParameterError(
-        "cannot find the bundled config/reference_rig.yaml (looked in "
-        + ", ".join(str(c) for c in candidates) + ")"
-    )
-
-
-def _ament_prefixes() -> list[str]:
-    return [p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
-
-
-def default_config_files() -> list[Path]:
-    """The params files that define the reference rig."""
-    return [default_config_dir() / "reference_rig.yaml"]
 
 
 @dataclass(frozen=True)
@@ -434,6 +422,9 @@ def _problem(spec: ParamSpec, value: Any) -> str | None:
         return f"must not be negative, got {value!r} [{spec.unit}]"
     if spec.positive and value == 0:
         return f"must be > 0, got {value!r} [{spec.unit}]"
+    if spec.key.endswith("_code") and (value != int(value) or value >= CODE_LIMIT):
+        return f"must be a basis function's code (a whole number below {CODE_LIMIT}), got " \
+            f"{value!r}"
     return None
 
 

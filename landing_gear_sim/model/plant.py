@@ -66,6 +66,14 @@ def tyre_state(p, x, vertical_load_n):
     return radius, hub, slip, force
 
 
+@njit(cache=True, inline="always")
+def wheel_extra(p, x, pressure_pa, vertical_load_n, slip):
+    """The torque of the wheel equation's slots at state ``x`` [N m]."""
+    signals = (x[OMEGA], x[SPEED], pressure_pa, vertical_load_n, abs(slip), x[E_BRAKE],
+               x[WHEEL_ANGLE], 0.0, 0.0)
+    return el.wheel_extra_torque(p, x[OMEGA]) + el.wheel_slot_torque(p, signals)
+
+
 @njit(cache=True)
 def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     """Write dx/dt of the plant state into ``dx`` (eqs. 1-8; rig or aircraft form)."""
@@ -88,10 +96,11 @@ def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     dx[SPEED] = accel
     dx[ANGLE] = x[ANGLE_RATE]
     dx[ANGLE_RATE] = angle_accel
-    dx[OMEGA] = el.wheel_acceleration(p, x[OMEGA], radius, fx, tb)
+    extra = wheel_extra(p, x, pressure_pa, vertical_load_n, slip)
+    dx[OMEGA] = el.wheel_acceleration(p, x[OMEGA], radius, fx, tb, extra)
     dx[E_BRAKE] = tb * max(x[OMEGA], 0.0)
     # the bearings' losses are drag's: they leave the flywheel and the wheel as heat
-    dx[E_DRAG] = drag * x[SPEED] + el.wheel_extra_torque(p, x[OMEGA]) * x[OMEGA]
+    dx[E_DRAG] = drag * x[SPEED] + extra * x[OMEGA]
     dx[E_SLIP] = fx * (hub - x[OMEGA] * radius)
     dx[E_DAMP] = p[el.GW_DAMPING] * x[ANGLE_RATE] ** 2 if p[el.HAS_GEAR_WALK] else 0.0
     steady = vertical_load_n * el.tyre_friction(p, slip, x[SPEED], vertical_load_n)
@@ -164,7 +173,8 @@ def record(p, x, time_s, current_a, pressure_pa, load_n, row):
     """Fill one output row (see CHANNELS) from the state at ``time_s``."""
     radius, hub, slip, fx = tyre_state(p, x, load_n)
     tb = el.brake_torque(p, pressure_pa, x[E_BRAKE], x[OMEGA], x[WHEEL_ANGLE])
-    omega_dot = el.wheel_acceleration(p, x[OMEGA], radius, fx, tb)
+    omega_dot = el.wheel_acceleration(p, x[OMEGA], radius, fx, tb,
+                                      wheel_extra(p, x, pressure_pa, load_n, slip))
     row[0], row[1], row[2] = time_s, current_a, pressure_pa
     row[3], row[4], row[5] = x[OMEGA], x[SPEED], hub
     row[6], row[7], row[8] = load_n, fx, slip

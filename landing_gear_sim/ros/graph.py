@@ -184,7 +184,7 @@ def controlled_run(run: RunSpec, controller: str | None) -> RunSpec:
 
 def options_from_arguments(values: dict[str, str]) -> tuple[GraphOptions, Path]:
     """GraphOptions and params file from launch arguments (strings, see LAUNCH_ARGUMENTS)."""
-    from landing_gear_sim.model.parameters import default_config_files
+    from landing_gear_sim.model.bundled import default_config_files
 
     def value(name: str) -> str:
         return values.get(name, LAUNCH_ARGUMENTS[name][0])

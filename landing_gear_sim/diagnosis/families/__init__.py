@@ -46,6 +46,7 @@ REGISTRY: tuple[Family, ...] = tuple(sorted((
     load.FAMILY,
     equation_terms.VALVE_FAMILY,
     equation_terms.WHEEL_FAMILY,
+    equation_terms.TYRE_FAMILY,
     equation_terms.FLYWHEEL_FAMILY,
     equation_terms.LOADING_FAMILY,
 ), key=lambda f: f.rank))

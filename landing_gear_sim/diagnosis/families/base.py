@@ -133,14 +133,16 @@ def term_candidate(family: Family, keys: Sequence[str], start: Sequence[float],
                    bounds: Sequence[tuple[float, float]], free: Sequence[str],
                    runs: tuple[Selector, ...], channels: tuple[str, ...],
                    held_out: tuple[Selector, ...] = (), names: Sequence[str] | None = None,
-                   reports: str = "") -> Candidate:
+                   reports: str = "", settings: Sequence[tuple[str, float]] = ()
+                   ) -> Candidate:
     """A discovered candidate of ``family`` (reported as ``reports``, default the family's):
     its slot ``keys`` fitted from ``start`` within ``bounds`` with the model parameters
     ``free`` on ``runs``, checked on ``held_out`` (none: half the fitting runs), compared on
-    ``channels``; contract ``names`` default to the keys' last part."""
+    ``channels``; contract ``names`` default to the keys' last part; ``settings``: set,
+    not fitted, in every model it is fitted from (a slot's basis codes)."""
     contract = tuple(zip(names or [k.split(".")[1] for k in keys], keys, strict=True))
     off = all(low <= 0.0 <= high for low, high in bounds)
     return Candidate(cause=DISCOVERED, element=None, keys=tuple(keys), starts=(tuple(start),),
                      bounds=tuple(bounds), free=tuple(free), runs=runs, channels=channels,
                      held_out=held_out, contract=contract, family=reports or family.reports,
-                     neutral=(0.0,) * len(keys) if off else ())
+                     neutral=(0.0,) * len(keys) if off else (), settings=tuple(settings))

@@ -12,6 +12,7 @@ is left when none of those is called for or accepted.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any, ClassVar
 
 import numpy as np
@@ -34,6 +35,9 @@ from landing_gear_sim.diagnosis.families.base import (
     term_candidate,
 )
 from landing_gear_sim.diagnosis.relations import Relation
+from landing_gear_sim.diagnosis.selection import Selected
+from landing_gear_sim.diagnosis.terms import BasisTerm, coefficient_unit, term_of
+from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import signed
@@ -56,35 +60,100 @@ class EquationTerms(Family):
 
     def __init_subclass__(cls) -> None:
         cls.reports = cls.equation = str(cls.library.equation)
-        cls.keys = tuple(t.key for t in cls.library.terms)
+        slot = cls.library.slot
+        cls.keys = tuple(coeff for _, coeff in slot.keys) if slot else tuple(
+            t.key for t in cls.library.terms)
         cls.relations = (cls.library.relation, *cls.also_breaks)
 
     def propose(self, evidence: Evidence) -> list[Proposal]:
         """The kept terms, started at their fit, fitted with the parameters the calibration
-        owns in the equation on the family's runs."""
+        owns in the equation on the family's runs; a basis function takes a free place of
+        the equation's generic slot."""
         if not evidence.violated(self.library.relation):
             return []
         chosen = self.library.select(evidence.campaign, evidence.model)
+        return [p for terms in _alternatives(chosen)
+                if (p := self._proposal(evidence, terms)) is not None]
+
+    def _proposal(self, evidence: Evidence, chosen: list[Selected]) -> Proposal | None:
+        slot = self.library.slot
+        if slot is None:
+            keys, settings = [s.term.key for s in chosen], []
+        else:
+            places = [pair for pair in slot.keys if evidence.model.number(pair[1]) == 0.0]
+            chosen = chosen[:len(places)]
+            keys = [coeff for _, coeff in places[:len(chosen)]]
+            settings = [(code, float(s.term.code or 0)) for (code, _), s in zip(
+                places, chosen, strict=False)]
         if not chosen:
-            return []
-        return [Proposal(term_candidate(
-            self, [s.term.key for s in chosen],
-            [float(np.clip(s.value, -0.9 * s.term.bound, 0.9 * s.term.bound)) for s in chosen],
-            [(-s.term.bound, s.term.bound) for s in chosen], self.free, self.runs,
-            self.channels, held_out=self.held_out))]
+            return None
+        bounds = [_bound(s) for s in chosen]
+        return Proposal(term_candidate(
+            self, keys, [float(np.clip(s.value, -0.9 * b, 0.9 * b)) for s, b in
+                         zip(chosen, bounds, strict=True)],
+            [(-b, b) for b in bounds], self.free, self.runs, self.channels,
+            held_out=self.held_out, names=[s.term.name for s in chosen], settings=settings))
+
+    def placed(self, params: RigParameters, name: str, value: float
+               ) -> tuple[str, RigParameters]:
+        """``params`` with the library's term ``name`` at ``value`` in the first place of
+        the generic slot, and that place's coefficient key (how a finding holds it)."""
+        slot = self.library.slot
+        term = next(t for t in self.library.terms if t.name == name)
+        if slot is None or term.code is None:
+            raise ValueError(f"{self.name} has no generic slot for {name}")
+        code, coeff = slot.keys[0]
+        return coeff, params.replace({code: float(term.code), coeff: value}, name)
 
     def formula(self, candidate: Candidate, params: RigParameters) -> str:
         sign = self.library.sign
-        written = " ".join(f"{signed(sign * params.number(t.key), t.unit)}{t.symbol}"
-                           for t in self.library.terms if t.key in candidate.keys)
+        slot = self.library.slot
+        if slot is None:
+            written = " ".join(f"{signed(sign * params.number(t.key), t.unit)}{t.symbol}"
+                               for t in self.library.terms if t.key in candidate.keys)
+        else:
+            written = " ".join(_written(sign * params.number(coeff), term_of(
+                round(params.number(code))), self.library.unit)
+                for code, coeff in slot.keys if params.number(coeff) != 0.0)
         return self.library.law(written, params)
 
 
-def _hidden(name: str, library: eq.Library[Any], key: str, span: tuple[float, float]) -> Hidden:
+ALTERNATIVES = 2  # terms the samples could not tell apart, tried each in its place
+
+
+def _alternatives(chosen: list[Selected]) -> list[list[Selected]]:
+    """``chosen``, and ``chosen`` with a term the regression's samples could not tell from
+    one of them in its place (up to ALTERNATIVES): a fit of the runs tells them apart, and
+    the search keeps the better (drag once applied, or while applied)."""
+    found = [chosen]
+    for i, selected in enumerate(chosen):
+        for alike in selected.alike:
+            found.append([*chosen[:i], replace(selected, term=alike, alike=()), *chosen[i + 1:]])
+    return found[:ALTERNATIVES + 1]
+
+
+BOUND_FACTOR = 10.0  # a basis term's coefficient within this many times its first fit
+
+
+def _bound(selected: Selected) -> float:
+    """A term's admissible magnitude: its own, or BOUND_FACTOR times its first fit."""
+    if np.isfinite(selected.term.bound):
+        return selected.term.bound
+    return BOUND_FACTOR * abs(selected.value)
+
+
+def _written(value: float, term: BasisTerm, equation_unit: str) -> str:
+    """One term of a law: '− 150 N m·[braked before]'."""
+    unit = coefficient_unit(equation_unit, term)
+    return f"{signed(value, '' if unit == '-' else unit)}·{term.name}"
+
+
+def _hidden(name: str, library: eq.Library[Any], key: str, span: tuple[float, float],
+            term: str = "") -> Hidden:
     """An effect in ``library``'s slot ``key``, drawn in ``span`` (its SI unit), found within
-    TOLERANCE."""
+    TOLERANCE as the coefficient of ``term`` (a basis function's name; default the key's)."""
     return Hidden(name, str(library.equation), lambda rng, datasheet: {key: rng.uniform(*span)},
-                  key, key.split(".")[1], TOLERANCE)
+                  key, term or key.split(".")[1], TOLERANCE)
 
 
 class WheelTerms(EquationTerms):
@@ -95,8 +164,11 @@ class WheelTerms(EquationTerms):
     also_breaks = (Relation.FREE_ROLLING,)
     free = (K.BRAKE_GAIN_N_M_PER_PA, *FRICTION)
     channels = WHEEL
-    hidden = (_hidden("wheel_bearing", eq.WHEEL, K.WHEEL_EXTRA_TORQUE_N_M, (40.0, 120.0)),
-              _hidden("wheel_seal", eq.WHEEL, K.WHEEL_EXTRA_TORQUE_N_M_S_PER_RAD, (0.3, 0.8)))
+    # drawn in the wheel's named slot (T₀ sgn ω, T₁ ω), found in its generic one
+    hidden = (_hidden("wheel_bearing", eq.WHEEL, K.WHEEL_EXTRA_TORQUE_N_M, (40.0, 120.0),
+                      "sgn ω"),
+              _hidden("wheel_seal", eq.WHEEL, K.WHEEL_EXTRA_TORQUE_N_M_S_PER_RAD, (0.3, 0.8),
+                      "ω"))
 
 
 class FlywheelTerms(EquationTerms):
@@ -113,7 +185,23 @@ class LoadingTerms(EquationTerms):
     library = eq.LOADING
     free = (K.LOADING_LIFT_COEFF_N_S2_PER_M2,)
     channels = ("vertical_load_n",)
-    hidden = (_hidden("load_sag", eq.LOADING, K.LOADING_EXTRA_LOAD_N_S_PER_M, (20.0, 60.0)),)
+    hidden = (_hidden("load_sag", eq.LOADING, K.LOADING_EXTRA_LOAD_N_S_PER_M, (20.0, 60.0),
+                      "v"),)
+
+
+class TyreTerms(EquationTerms):
+    name = "tyre_equation"
+    library = eq.TYRE
+    free = FRICTION
+    channels = WHEEL
+    # a friction that falls with the sliding speed (the seed paper's ref. [8]), drawn in
+    # the tyre's generic slot as μ_B·v: 12-24 % less at 60 m/s
+    hidden = (Hidden("tyre_speed", "tyre", lambda rng, datasheet: {
+        K.TYRE_TERMS[0][0]: float(basis.product_code(
+            basis.factor_code(basis.CURVE, basis.IDENTITY),
+            basis.factor_code(basis.SPEED, basis.IDENTITY))),
+        K.TYRE_TERMS[0][1]: rng.uniform(-0.004, -0.002)}, K.TYRE_TERMS[0][1], "μ_B·v",
+        TOLERANCE),)
 
 
 class ValveTerms(EquationTerms):
@@ -131,3 +219,4 @@ VALVE_FAMILY = ValveTerms()
 WHEEL_FAMILY = WheelTerms()
 FLYWHEEL_FAMILY = FlywheelTerms()
 LOADING_FAMILY = LoadingTerms()
+TYRE_FAMILY = TyreTerms()

@@ -1,0 +1,151 @@
+"""Term libraries that compose (issue 41), as pysindy's feature libraries do: each library
+owns its terms' names, apart from the solver that selects among them.
+
+A term is a basis function of an equation's generic slot (:mod:`landing_gear_sim.model.basis`,
+whose code the plant evaluates): :class:`Shaped` puts signals through shapes (``sgn ω``,
+``|v|·v``, ``[braked before]``, ``t_c``), ``a + b`` joins two libraries, ``a * b`` takes
+every product of a term of one with a term of the other (pysindy's tensored library). An
+equation's library is written once from these, over the signals the equation sees
+(``calibration.slots.SEES``); the names, units and codes follow from the composition.
+"""
+
+from __future__ import annotations
+
+import abc
+import itertools
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from landing_gear_sim.model import basis
+from msg_tools.units import display
+
+
+@dataclass(frozen=True)
+class BasisTerm:
+    """One basis function: its code in the plant's slot, its name as a law writes it, and
+    its SI unit ('-' when it has none)."""
+
+    code: int
+    name: str
+    unit: str
+
+
+_SHAPE_NAMES: dict[int, str] = {
+    basis.IDENTITY: "{x}", basis.SIGN: "sgn {x}", basis.SIGNED_SQUARE: "|{x}|·{x}",
+    basis.SQUARE: "{x}²", basis.CUBE: "{x}³", basis.STEP: "[{x} > {floor}]",
+    basis.DEAD_ZONE: "dz({x}, {floor})", basis.SIGNED_ROOT: "√{x}", basis.COS1: "cos {x}",
+    basis.SIN1: "sin {x}", basis.COS2: "cos 2{x}", basis.SIN2: "sin 2{x}",
+}
+_SHAPE_POWERS: dict[int, float] = {
+    basis.IDENTITY: 1, basis.SIGNED_SQUARE: 2, basis.SQUARE: 2, basis.CUBE: 3,
+    basis.DEAD_ZONE: 1, basis.SIGNED_ROOT: 0.5}
+"""The power of the signal's unit a shape leaves (the others leave none)."""
+_NAMED_STEPS: dict[int, str] = {basis.BRAKE_ENERGY: "[braked before]"}
+"""Steps with a name of their own (the brake has absorbed more than its floor)."""
+
+
+def _power(unit: str, power: float) -> str:
+    if unit == "-" or power == 0:
+        return "-"
+    if power == 1:
+        return unit
+    shown = f"{power:g}"
+    return f"({unit})^{shown}" if " " in unit or "/" in unit else f"{unit}^{shown}"
+
+
+def factor_term(signal: int, shape: int) -> BasisTerm:
+    """The basis function of one ``signal`` through ``shape``."""
+    symbol, unit = basis.SIGNALS[signal]
+    floor = display(float(basis.FLOORS[signal]), unit, ".3g")
+    name = _NAMED_STEPS.get(signal) if shape == basis.STEP else None
+    return BasisTerm(basis.factor_code(signal, shape),
+                     name or _SHAPE_NAMES[shape].format(x=symbol, floor=floor),
+                     _power(unit, _SHAPE_POWERS.get(shape, 0)))
+
+
+def product_term(first: BasisTerm, second: BasisTerm) -> BasisTerm:
+    """The product of two one-factor terms."""
+    units = [u for u in (first.unit, second.unit) if u != "-"]
+    return BasisTerm(basis.product_code(first.code, second.code), f"{first.name}·{second.name}",
+                     " ".join(units) or "-")
+
+
+def term_of(code: int) -> BasisTerm:
+    """The basis function of ``code`` (its name and unit from its factors)."""
+    parts = [factor_term(f // basis.FACTOR, f % basis.FACTOR) for f in basis.factors(code)]
+    return parts[0] if len(parts) == 1 else product_term(*parts)
+
+
+def coefficient_unit(equation_unit: str, term: BasisTerm) -> str:
+    """The unit of a coefficient of ``term`` in an equation of ``equation_unit``."""
+    if term.unit == "-":
+        return equation_unit
+    per = f"({term.unit})" if " " in term.unit or "/" in term.unit else term.unit
+    return f"{equation_unit}/{per}" if equation_unit != "-" else f"1/{per}"
+
+
+class TermLibrary(abc.ABC):
+    """A set of basis functions, composable: ``+`` joins, ``*`` takes products."""
+
+    @abc.abstractmethod
+    def terms(self) -> tuple[BasisTerm, ...]:
+        """The library's basis functions, in a fixed order, each once."""
+
+    def __add__(self, other: TermLibrary) -> TermLibrary:
+        return Joined((self, other))
+
+    def __mul__(self, other: TermLibrary) -> TermLibrary:
+        return Tensored(self, other)
+
+    def __len__(self) -> int:
+        return len(self.terms())
+
+
+@dataclass(frozen=True)
+class Shaped(TermLibrary):
+    """Every one of ``signals`` through every one of ``shapes`` (``model.basis`` indices)."""
+
+    signals: Sequence[int]
+    shapes: Sequence[int]
+
+    def terms(self) -> tuple[BasisTerm, ...]:
+        return tuple(factor_term(s, f) for s in self.signals for f in self.shapes)
+
+
+@dataclass(frozen=True)
+class Joined(TermLibrary):
+    """The terms of each library, the first occurrence of each code kept."""
+
+    parts: Sequence[TermLibrary]
+
+    def terms(self) -> tuple[BasisTerm, ...]:
+        seen: dict[int, BasisTerm] = {}
+        for term in itertools.chain.from_iterable(p.terms() for p in self.parts):
+            seen.setdefault(term.code, term)
+        return tuple(seen.values())
+
+
+@dataclass(frozen=True)
+class Tensored(TermLibrary):
+    """Every product of a term of ``first`` with a term of ``second`` of another signal (a
+    signal times itself is a shape's business)."""
+
+    first: TermLibrary
+    second: TermLibrary
+
+    def terms(self) -> tuple[BasisTerm, ...]:
+        return tuple(product_term(a, b) for a in self.first.terms()
+                     for b in self.second.terms()
+                     if a.code // basis.FACTOR != b.code // basis.FACTOR)
+
+
+@dataclass(frozen=True)
+class Without(TermLibrary):
+    """``library`` less the terms whose codes the equation's own parameters already own
+    (k_b P in the wheel's balance, k_L v² in the loading device's)."""
+
+    library: TermLibrary
+    owned: frozenset[int]
+
+    def terms(self) -> tuple[BasisTerm, ...]:
+        return tuple(t for t in self.library.terms() if t.code not in self.owned)

@@ -29,6 +29,8 @@ from landing_gear_sim.model.parameters import RigParameters
 
 MIN_EFFECT = 0.005  # a term's rms effect over the equation's scale: half a per cent
 MAX_KEPT = basis.SLOT_TERMS  # terms a slot holds
+SPANNED = 1e-3  # a column this close to the span of those before it adds nothing
+ALIKE = 0.05  # a column this close to one before it alone is that one, as the samples see
 NOISE_FLOOR = 3.0  # times the error the regressors' own noise makes
 
 S = TypeVar("S")  # what a library reads one run's rows from: a braking run's signals, ...
@@ -148,36 +150,36 @@ def fit_terms(terms: Sequence[Term[Any]], rows: Sequence[Rows]) -> Fitted | None
                   _joint_z(x[:, kept], owned, y))
 
 
-def _told_apart(x: np.ndarray, owned: np.ndarray, tolerance: float = 1e-3) -> list[int]:
+def _told_apart(x: np.ndarray, owned: np.ndarray) -> list[int]:
     """The columns of ``x`` the samples tell apart from the owned ones and from the columns
-    before them (a column within ``tolerance`` of their span, relative, is left out: on
-    the steady braking samples '[P > 0.5 bar]' and '[braked before]' are one column; a
-    column a little apart, as e³ from 1, e, e² on the valve's map, is the lasso's to
-    judge)."""
+    before them: a column within SPANNED of their span, or within ALIKE of one of them alone
+    (beside the owned ones), relative, is left out. On the steady braking samples
+    '[P > 0.5 bar]' and '[braked before]' are one column, and 'sgn ω·[P > 0.5 bar]' differs
+    only where the wheel locked (the two shared 150 N m out half and half); a column a
+    little apart from several, as e³ from 1, e, e² on the valve's map, is the lasso's to
+    judge."""
     chosen: list[int] = []
     for column in range(x.shape[1]):
-        basis_ = np.hstack([owned, x[:, chosen]])
-        target = x[:, column]
-        coef, *_ = np.linalg.lstsq(basis_, target, rcond=None)
-        if np.linalg.norm(target - basis_ @ coef) > tolerance * np.linalg.norm(target):
+        if _residual(x[:, column], np.hstack([owned, x[:, chosen]])) > SPANNED and not any(
+                _residual(x[:, column], np.hstack([owned, x[:, [c]]])) <= ALIKE
+                for c in chosen):
             chosen.append(column)
     return chosen
 
 
-def _alike(x: np.ndarray, owned: np.ndarray, column: int, apart: Sequence[int],
-           tolerance: float = 1e-3) -> list[int]:
+def _residual(target: np.ndarray, design: np.ndarray) -> float:
+    """How far ``target`` is from the span of ``design``'s columns, relative to its norm."""
+    coef, *_ = np.linalg.lstsq(design, target, rcond=None)
+    return float(np.linalg.norm(target - design @ coef) / max(np.linalg.norm(target), 1e-300))
+
+
+def _alike(x: np.ndarray, owned: np.ndarray, column: int, apart: Sequence[int]) -> list[int]:
     """The columns left out as not told apart that repeat ``column`` alone (beside the owned
-    ones, one for one) within ``tolerance``, relative: the samples cannot say which of them
-    the error holds; a fit of the rig's runs can ('[braked before]' and '[P > 0.5 bar]'
-    part where an oscillating brake releases)."""
-    found = []
-    for other in sorted(set(range(x.shape[1])) - set(apart)):
-        design = np.hstack([owned, x[:, [column]]])
-        coef, *_ = np.linalg.lstsq(design, x[:, other], rcond=None)
-        if np.linalg.norm(x[:, other] - design @ coef) <= tolerance * np.linalg.norm(
-                x[:, other]) and abs(coef[-1] - 1.0) < 2 * tolerance:
-            found.append(other)
-    return found
+    ones) within ALIKE: the samples cannot say which of them the error holds; a fit of the
+    rig's runs can ('[braked before]' and '[P > 0.5 bar]' part where an oscillating brake
+    releases)."""
+    return [other for other in sorted(set(range(x.shape[1])) - set(apart))
+            if _residual(x[:, other], np.hstack([owned, x[:, [column]]])) <= ALIKE]
 
 
 def _joint_z(kept: np.ndarray, owned: np.ndarray, y: np.ndarray) -> float:

@@ -27,6 +27,7 @@ from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
+from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.io import read_campaign
 
 RNG = np.random.default_rng(41)
@@ -207,3 +208,49 @@ def test_a_cylinder_that_leaks_is_discovered_in_the_loading_device_not_none(refe
     finding = _first(result, "loading device")
     assert finding.parameters["t_c"] == pytest.approx(leak, rel=0.1)
     assert "t_c" in finding.term
+
+
+def test_the_f_x_channel_reads_its_slot_and_its_true_value_takes_it_off(reference):
+    drift = basis.factor_code(basis.RUN_TIME, basis.IDENTITY)
+    drifting = _with_terms(reference, Slot.FX_CHANNEL, [(drift, 40.0)])
+    sensors = SensorModel.of(drifting)
+    time = np.linspace(0.0, 10.0, 11)
+    force, load = np.full(11, 5e3), np.full(11, 3e4)
+    read = sensors.longitudinal(force, load, time_s=time)
+    assert read - force == pytest.approx(40.0 * time)
+    assert sensors.true_longitudinal(read, load, time) == pytest.approx(force)
+    assert sensors.longitudinal(5e3, 3e4, time_s=2.0) == pytest.approx(5e3 + 80.0)
+    assert np.array_equal(SensorModel.of(reference).longitudinal(force, load, time_s=time),
+                          force)  # no term: the reading as before, to the bit
+
+
+def test_a_load_cell_that_drifts_is_discovered_in_the_f_x_channel_not_the_wheel(reference,
+                                                                              tmp_path):
+    """U06's failure (a zero drifting 40 N/s named a wheel bearing): a drift drawn here; the
+    flywheel feels the true F_x, the channel reads it wrong."""
+    rate = float(np.random.default_rng(413).uniform(20.0, 60.0))
+    result = _diagnosed(reference, tmp_path, 413, Slot.FX_CHANNEL, [
+        (basis.factor_code(basis.RUN_TIME, basis.IDENTITY), rate)])
+    finding = _first(result, "F_x channel")
+    assert finding.parameters["t"] == pytest.approx(rate, rel=0.1)
+    assert finding.term.startswith("F_x,read = F_x")
+
+
+def test_the_diagnosis_contract_lists_each_generic_slots_library_as_composed():
+    """docs/diagnosis.md's table of the generic slots' libraries: one row per equation with
+    a generic slot, naming every signal its library composes and the slot's keys."""
+    import re
+    from pathlib import Path
+
+    page = (Path(__file__).parents[1] / "docs" / "diagnosis.md").read_text()
+    cells = [re.split(r"(?<!\\)\|", line) for line in page.splitlines()
+             if line.startswith("| ")]
+    rows = {c[1].strip(): "|".join(c) for c in cells if len(c) == 5}
+    for library in (eq.WHEEL, eq.TYRE, eq.LOADING, eq.FX_CHANNEL):
+        row = rows[str(library.equation)]
+        symbols = {basis.SIGNALS[f // basis.FACTOR][0] for t in library.terms
+                   for f in basis.factors(t.code or 0)}
+        assert all(symbol in row for symbol in symbols), (library.equation, symbols)
+        assert library.slot is not None
+        code_key = library.slot.keys[0][0]
+        assert f"`{code_key.replace('_1_code', '_<k>_*')}`" in page, code_key

@@ -4,6 +4,7 @@ torque balance r F_x − J_w ω̇ = k_b P. Signals are low-passed (zero phase) f
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -79,9 +80,42 @@ def prepare(run: ClassifiedRun, p: RigParameters) -> Braking:
         pressure=lowpass(sensors.true_pressure(run.pressure_pa), rate),
         load=lowpass(run.vertical_load_n, rate),
         force=lowpass(sensors.true_longitudinal(run.longitudinal_force_n,
-                                                run.vertical_load_n), rate),
+                                                run.vertical_load_n, run_time_s(run)), rate),
         start_s=run.brake_start_s - float(run.time_s[0]),
     )
+
+
+def in_step(b: Braking, p: RigParameters) -> Braking:
+    """``b`` with its pressure taken back by the model's delay of the pressure channel (the
+    pressure that made the torque at each sample; ``b`` itself when the channel is in
+    step)."""
+    delay = SensorModel.of(p).pressure_delay_s
+    if delay <= 0.0:
+        return b
+    return dataclasses.replace(b, pressure=np.interp(b.time_s + delay, b.time_s, b.pressure))
+
+
+def run_time_s(run: ClassifiedRun) -> np.ndarray:
+    """Each sample's time since the run's first [s] (a channel that drifts counts it)."""
+    return run.time_s - run.time_s[0]
+
+
+def free_rolling_excess(b: Braking, params: RigParameters) -> tuple[np.ndarray, np.ndarray]:
+    """The samples before the brake acts (mask), and the F_x there (the model's crosstalk
+    taken off the reading) less the wheel's inertia force J_w ω̇ / r and the force the tyre
+    pushes the model's own wheel torque with (its generic slot: a bearing's) [N]: what the
+    load cell reads beyond the physics."""
+    m = free_rolling(b)
+    radius = rolling_radius_at(params, b.load[m])
+    torque = (params.number(K.WHEEL_INERTIA_KG_M2) * b.wheel_rate[m]
+              + wheel_extra_torque(params.vector(), b.wheel[m]))
+    if Slot.WHEEL.occupied(params):
+        _, energy = torque_balance(b, params)
+        torque = torque + Slot.WHEEL.value_of(params, measured_signals(b, params, energy))[m]
+    force = SensorModel.of(params).true_longitudinal(b.run.longitudinal_force_n[m],
+                                                     b.run.vertical_load_n[m],
+                                                     run_time_s(b.run)[m])
+    return m, force - torque / radius
 
 
 def slip(b: Braking, p: RigParameters) -> np.ndarray:

@@ -27,12 +27,13 @@ class Slot(str, enum.Enum):
     WHEEL = "wheel"
     TYRE = "friction"
     LOADING = "loading"
+    FX_CHANNEL = "sensors"
 
     @property
     def keys(self) -> tuple[tuple[str, str], ...]:
         """Its (code, coefficient) keys."""
         return {"wheel": K.WHEEL_TERMS, "friction": K.TYRE_TERMS,
-                "loading": K.LOADING_TERMS}[self.value]
+                "loading": K.LOADING_TERMS, "sensors": K.FX_TERMS}[self.value]
 
     def value_of(self, params: RigParameters, measured: np.ndarray) -> np.ndarray:
         """The slot of ``params`` at each row of ``measured`` (:func:`signals`)."""
@@ -50,6 +51,7 @@ SEES: dict[Slot, tuple[int, ...]] = {
                  basis.BRAKE_ENERGY, basis.WHEEL_ANGLE),
     Slot.TYRE: (basis.SPEED, basis.LOAD, basis.SLIP, basis.CURVE),
     Slot.LOADING: (basis.SPEED, basis.CONTACT_TIME),
+    Slot.FX_CHANNEL: (basis.LOAD, basis.RUN_TIME),
 }
 """The signals each equation's slot sees in the plant (``model.elements``)."""
 
@@ -81,4 +83,5 @@ def signals(time_s: np.ndarray, wheel_rad_s: np.ndarray, speed_m_s: np.ndarray,
     out[:, basis.CONTACT_TIME] = np.maximum(
         time_s - params.number(K.RIG_TEST_TOUCHDOWN_S), 0.0)
     out[:, basis.CURVE] = friction_at(params, out[:, basis.SLIP])
+    out[:, basis.RUN_TIME] = time_s - time_s[0]
     return out

@@ -204,8 +204,8 @@ def brake_ripple_design(run: ClassifiedRun, params: RigParameters,
     rate = run.rate_hz
     cutoff = min(RIPPLE_FILTER_HZ, NYQUIST_SHARE * rate / 2)
     wheel = br.lowpass(wheel, rate, cutoff)
-    force = br.lowpass(sensors.true_longitudinal(run.longitudinal_force_n, run.vertical_load_n),
-                       rate, cutoff)
+    force = br.lowpass(sensors.true_longitudinal(run.longitudinal_force_n, run.vertical_load_n,
+                                                 br.run_time_s(run)), rate, cutoff)
     torque = rolling_radius_at(params, b.load) * force - params.number(
         K.WHEEL_INERTIA_KG_M2) * np.gradient(wheel, 1.0 / rate)
     _, energy = br.torque_balance(b, params)

@@ -26,7 +26,6 @@ Z_VIOLATED σ and the floor. No plotting here (:mod:`landing_gear_sim.report.dia
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Sequence
 
@@ -35,7 +34,6 @@ import numpy as np
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.plausibility import counted_wheel_step
 from landing_gear_sim.calibration.runs import ClassifiedRun
-from landing_gear_sim.calibration.slots import Slot
 from landing_gear_sim.calibration.statistics import (
     inverse_variance_weights,
     linear_std,
@@ -66,10 +64,8 @@ from landing_gear_sim.diagnosis.settled_valve import (
     SETTLED_S,
     settled_valve,
 )
-from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.model.quantities import rolling_radius_at
 from landing_gear_sim.model.scenario import (
     commanded,
 )
@@ -161,10 +157,11 @@ def _run_checks(run: ClassifiedRun, prepared: br.Braking | None, params: RigPara
         checks.extend([_free_rolling(prepared, params), _wheel_angle(run, params),
                        _brake_angle(run, prepared, params)])
     else:
+        fx = SensorModel.of(params).true_longitudinal(run.longitudinal_force_n,
+                                                      run.vertical_load_n, br.run_time_s(run))
         checks.extend(_mean_check(Relation.NO_CONTACT, run.name, f"whole run, {label}",
-                                  getattr(run, name), FORCE_FLOOR_N, "N", run.rate_hz)
-                      for name, label in (("vertical_load_n", "F_z"),
-                                          ("longitudinal_force_n", "F_x")))
+                                  values, FORCE_FLOOR_N, "N", run.rate_hz)
+                      for values, label in ((run.vertical_load_n, "F_z"), (fx, "F_x")))
         checks.append(_valve_direction(run, params))
     return [c for c in checks if c is not None]
 
@@ -236,25 +233,8 @@ def _zero_current(run: ClassifiedRun, params: RigParameters) -> Check | None:
                        PRESSURE_FLOOR_PA, "Pa", run.rate_hz)
 
 
-def free_rolling_excess(b: br.Braking, params: RigParameters) -> tuple[np.ndarray, np.ndarray]:
-    """The samples before the brake acts (mask), and the F_x there (the model's crosstalk
-    taken off the reading) less the wheel's inertia force J_w ω̇ / r and the force the tyre
-    pushes the model's own wheel torque with (its generic slot: a bearing's) [N]: what the
-    load cell reads beyond the physics."""
-    m = br.free_rolling(b)
-    radius = rolling_radius_at(params, b.load[m])
-    torque = (params.number(K.WHEEL_INERTIA_KG_M2) * b.wheel_rate[m]
-              + el.wheel_extra_torque(params.vector(), b.wheel[m]))
-    if Slot.WHEEL.occupied(params):
-        _, energy = br.torque_balance(b, params)
-        torque = torque + Slot.WHEEL.value_of(params, br.measured_signals(b, params, energy))[m]
-    force = SensorModel.of(params).true_longitudinal(b.run.longitudinal_force_n[m],
-                                                     b.run.vertical_load_n[m])
-    return m, force - torque / radius
-
-
 def _free_rolling(b: br.Braking, params: RigParameters) -> Check | None:
-    _, excess = free_rolling_excess(b, params)
+    _, excess = br.free_rolling_excess(b, params)
     return _mean_check(FREE_ROLLING, b.run.name, "before braking", excess, FORCE_FLOOR_N, "N",
                        b.run.rate_hz)
 
@@ -293,11 +273,9 @@ def _pressure_timing(runs: Sequence[br.Braking], params: RigParameters) -> list[
     the measured pressure in step with the torque; a channel stamped late does not (an
     actuator delay and a wheel channel 'leading' by as much were once reported together).
     Away from lock (slip < MAX_BRAKING_SLIP), where the balance's derivative dominates."""
-    delay = SensorModel.of(params).pressure_delay_s
     rows, columns = [], []
     for b in runs:
-        if delay > 0.0:
-            b = dataclasses.replace(b, pressure=np.interp(b.time_s + delay, b.time_s, b.pressure))
+        b = br.in_step(b, params)
         torque, energy = br.torque_balance(b, params)
         model = br.model_torque(b, params, energy, np.arange(b.time_s.size))
         slope = np.gradient(model, 1.0 / b.run.rate_hz)

@@ -50,7 +50,8 @@ from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import friction_coefficients, load_factor_at
-from msg_tools.units import display
+from landing_gear_sim.model.sensors import SensorModel
+from msg_tools.units import display, signed
 
 EDGE_S = 0.5  # the zero-phase filter's ends are left out
 SETTLE_S = 0.5  # after the touch-down ramp, before the loading device's load is its law
@@ -175,6 +176,7 @@ class WheelLibrary(BrakingLibrary):
         index = _thinned(br.steady_braking_samples(b) | br.free_rolling(b), b.run.rate_hz)
         if index.size < 20:
             return None
+        b = br.in_step(b, params)  # a late pressure channel's error is its own family's
         torque, energy = br.torque_balance(b, params)
         model = br.model_torque(b, params, energy, index)
         measured = seen(Slot.WHEEL, br.measured_signals(b, params, energy)[index])
@@ -318,6 +320,63 @@ class TyreLibrary(BrakingLibrary):
         return f"μ = μ_B(λ)·g(F_z) {written}"
 
 
+FX_TERMS = (Shaped((basis.RUN_TIME,), (basis.IDENTITY, basis.SQUARE, basis.SIGNED_ROOT))
+            + Shaped((basis.LOAD,), (basis.SIGNED_SQUARE,))
+            + Shaped((basis.RUN_TIME,), (basis.IDENTITY,)) * Shaped((basis.LOAD,),
+                                                                   (basis.IDENTITY,)))
+"""The F_x channel's library: a zero that drifts with the time since the run's start (a
+load cell warming), and a reading that bends with the load; F_z alone is the named
+``channel_crosstalk``'s."""
+KNOWN_RATE_HZ = 100.0  # samples where F_x is known, thinned to this
+
+
+class FxChannelLibrary(Library[tuple[ClassifiedRun, "br.Braking | None"]]):
+    """The load cell's F_x channel, F_x,read = F_x + c F_z + Σ c_k φ_k(F_z, t): its error is
+    the reading less the true F_x where that is known — off the ground (0) and in the free
+    rolling before the brake acts (the wheel's inertia force and the model's wheel torque,
+    pushed by the tyre)."""
+
+    equation = Equation.FX_CHANNEL
+    relation = Relation.FX_CHANNEL
+    unit = "N"
+    phase = "where F_x is known"
+    slot = Slot.FX_CHANNEL
+    sign = 1.0
+    terms = basis_terms(FX_TERMS, "N")
+
+    def sources(self, campaign: Campaign, params: RigParameters
+                ) -> list[tuple[ClassifiedRun, br.Braking | None]]:
+        prepared = {b.run.name: b for b in campaign.braking}
+        return [(r, prepared.get(r.name)) for r in campaign.runs]
+
+    def rows(self, source: tuple[ClassifiedRun, br.Braking | None], params: RigParameters,
+             terms: Sequence[Term[tuple[ClassifiedRun, br.Braking | None]]] | None = None
+             ) -> Rows | None:
+        run, b = source
+        time = br.run_time_s(run)
+        if b is not None:
+            mask, excess = br.free_rolling_excess(b, params)
+            index, error = np.flatnonzero(mask), excess
+        else:
+            index = np.arange(len(run))
+            error = np.asarray(SensorModel.of(params).true_longitudinal(
+                run.longitudinal_force_n, run.vertical_load_n, time))
+        step = max(1, round(run.rate_hz / KNOWN_RATE_HZ))
+        index, error = index[::step], error[::step]
+        if index.size < 20:
+            return None
+        measured = np.zeros((index.size, basis.N_SIGNALS))
+        measured[:, basis.LOAD] = run.vertical_load_n[index]
+        measured[:, basis.RUN_TIME] = time[index]
+        return Rows(error, term_columns(terms or self.terms, source, params, index, measured),
+                    np.zeros((index.size, 0)), params.number(K.LOADING_STATIC_LOAD_N))
+
+    def law(self, written: str, params: RigParameters) -> str:
+        crosstalk = params.number(K.SENSORS_CROSSTALK_FX_PER_FZ)
+        shown = f" {signed(crosstalk, spec='.4g')}·F_z" if crosstalk else ""
+        return f"F_x,read = F_x{shown} {written}"
+
+
 def _slip_noise(b: br.Braking, index: np.ndarray) -> np.ndarray:
     """The 1-σ of the slip at the samples ``index`` that the wheel channel's noise leaves
     through the calibration's low-pass: the channel's noise (first differences) over the
@@ -376,7 +435,8 @@ WHEEL = WheelLibrary()
 TYRE = TyreLibrary()
 FLYWHEEL = FlywheelLibrary()
 LOADING = LoadingLibrary()
-LIBRARIES: tuple[Library[Any], ...] = (VALVE, WHEEL, TYRE, FLYWHEEL, LOADING)
+FX_CHANNEL = FxChannelLibrary()
+LIBRARIES: tuple[Library[Any], ...] = (VALVE, WHEEL, TYRE, FLYWHEEL, LOADING, FX_CHANNEL)
 
 
 def equation_checks(campaign: Campaign, params: RigParameters) -> list[Check]:

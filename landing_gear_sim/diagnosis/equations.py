@@ -34,6 +34,7 @@ class Equation(str, enum.Enum):
     TYRE = "tyre"
     FLYWHEEL = "flywheel"
     LOADING = "loading device"
+    FX_CHANNEL = "F_x channel"
 
     def __str__(self) -> str:
         return self.value
@@ -45,7 +46,8 @@ class Equation(str, enum.Enum):
                 "wheel": "J_w·ω̇ = r·F_x − T_b (wheel rotation)",
                 "tyre": "F_x = F_z·μ(λ) (tyre force)",
                 "flywheel": "m_f·v̇ = −F_x − F_drag (flywheel)",
-                "loading device": "F_z follows F_z0 − k_L·v² (loading device)"}[self.value]
+                "loading device": "F_z follows F_z0 − k_L·v² (loading device)",
+                "F_x channel": "F_x,read = F_x (the load cell's F_x channel)"}[self.value]
 
 
 @dataclass(frozen=True)

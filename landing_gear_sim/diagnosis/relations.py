@@ -35,6 +35,7 @@ class Relation(str, enum.Enum):
     LOADING_LAW = "vertical load follows F_z0 − k_L v²"
     VALVE_MAP = "valve settles on its quadratic static map"
     TYRE_LAW = "tyre follows its friction curve"
+    FX_CHANNEL = "F_x channel reads F_x where it is known"
 
     def __str__(self) -> str:
         return self.value
@@ -67,6 +68,7 @@ _WHERE = {
     "LOADING_LAW": ("loading device", "vertical_load_n"),
     "VALVE_MAP": ("valve", "pressure_pa"),
     "TYRE_LAW": ("tyre", "wheel_speed_rad_s"),
+    "FX_CHANNEL": ("F_x channel", "longitudinal_force_n"),
 }
 @dataclass(frozen=True)
 class Check:

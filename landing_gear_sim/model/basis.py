@@ -24,15 +24,16 @@ from numba import njit
 # The signals an equation may see (one tuple of N_SIGNALS floats; an equation leaves at 0
 # what it does not see). Each has a floor: below it, a step counts the signal as absent and
 # a dead zone passes nothing (a noisy zero is not a signal).
-(OMEGA, SPEED, PRESSURE, LOAD, SLIP, BRAKE_ENERGY, WHEEL_ANGLE, CONTACT_TIME,
- CURVE) = range(9)
-N_SIGNALS = 9
+(OMEGA, SPEED, PRESSURE, LOAD, SLIP, BRAKE_ENERGY, WHEEL_ANGLE, CONTACT_TIME, CURVE,
+ RUN_TIME) = range(10)
+N_SIGNALS = 10
 SIGNALS: tuple[tuple[str, str], ...] = (
     ("ω", "rad/s"), ("v", "m/s"), ("P", "Pa"), ("F_z", "N"), ("λ", "-"), ("E_b", "J"),
-    ("θ", "rad"), ("t_c", "s"), ("μ_B", "-"))
+    ("θ", "rad"), ("t_c", "s"), ("μ_B", "-"), ("t", "s"))
 """Each signal's symbol and SI unit, by index (μ_B: the tyre's calibrated curve at the
-slip, so a term may scale it: a friction that falls with speed is μ_B·v)."""
-FLOORS = np.array([1.0, 0.5, 0.5e5, 1000.0, 0.005, 1e4, 0.0, 0.0, 0.01])
+slip, so a term may scale it: a friction that falls with speed is μ_B·v; t: the time since
+the run's first sample, as a channel that drifts counts it)."""
+FLOORS = np.array([1.0, 0.5, 0.5e5, 1000.0, 0.005, 1e4, 0.0, 0.0, 0.01, 0.0])
 """Each signal's floor [its SI unit]: 1 rad/s, 0.5 m/s, 0.5 bar, 1 kN, 0.5 % slip, 10 kJ."""
 
 # The shapes a signal goes through; parameter-free, or scaled by the signal's floor.
@@ -111,7 +112,8 @@ def term_values(code, signals):
     out = np.empty(signals.shape[0])
     for i in range(out.shape[0]):
         s = signals[i]
-        out[i] = term_value(code, (s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[8]))
+        out[i] = term_value(code, (s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[8],
+                                    s[9]))
     return out
 
 
@@ -122,7 +124,7 @@ def slot_values(p, first, signals):
     for i in range(out.shape[0]):
         s = signals[i]
         out[i] = slot_value(p, first, (s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7],
-                                        s[8]))
+                                        s[8], s[9]))
     return out
 
 

@@ -147,7 +147,7 @@ class PlantBlock:
             flywheel_speed_rad_s=float(sensors.speed(
                 quantities.flywheel_speed_rad_s(self._params, row[4]), rng)),
             vertical_load_n=float(sensors.force(row[6], rng)),
-            longitudinal_force_n=float(sensors.longitudinal(row[7], row[6], rng)))
+            longitudinal_force_n=float(sensors.longitudinal(row[7], row[6], rng, row[0])))
 
     def _wheel_read(self, time_s: float, wheel_rad_s: float) -> float:
         """The wheel channel's noise-free reading now (out of step: from recent samples)."""

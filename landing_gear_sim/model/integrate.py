@@ -138,7 +138,8 @@ class SimulationResult:
                                                rng),
             vertical_load_n=sensors.force(self.vertical_load_n, rng),
             longitudinal_force_n=sensors.longitudinal(self.longitudinal_force_n,
-                                                      self.vertical_load_n, rng),
+                                                      self.vertical_load_n, rng,
+                                                      self.time_s - self.time_s[0]),
         )
 
 

@@ -96,11 +96,13 @@ LOADING_EXTRA_LOAD_N_S_PER_M: Final = "loading.extra_load_n_s_per_m"
 ACTUATOR_EXTRA_MAP_PA_PER_A3: Final = "actuator.extra_map_pa_per_a3"
 
 
-def _slot_terms(equation: str) -> tuple[tuple[str, str], ...]:
+def _slot_terms(section: str, term: str = "term") -> tuple[tuple[str, str], ...]:
     """An equation's generic slot (``model.basis``): its (code, coefficient) keys."""
-    return tuple((f"{equation}.term_{k}_code", f"{equation}.term_{k}_coeff") for k in (1, 2, 3))
+    return tuple((f"{section}.{term}_{k}_code", f"{section}.{term}_{k}_coeff")
+                 for k in (1, 2, 3))
 
 
 WHEEL_TERMS: Final = _slot_terms("wheel")
 TYRE_TERMS: Final = _slot_terms("friction")
 LOADING_TERMS: Final = _slot_terms("loading")
+FX_TERMS: Final = _slot_terms("sensors", "fx_term")

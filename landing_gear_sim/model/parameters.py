@@ -206,6 +206,8 @@ SPECS: tuple[ParamSpec, ...] = (
                  "+ sum c_k phi_k"),
     *_slot_terms(K.LOADING_TERMS, "N", "the loading device's set point: F_z0 - k_L v^2 - "
                  "sum c_k phi_k"),
+    *_slot_terms(K.FX_TERMS, "N", "the load cell's F_x channel: F_x,read = F_x + c F_z + "
+                 "sum c_k phi_k"),
 )
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}

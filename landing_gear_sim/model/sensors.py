@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import Value
@@ -38,6 +39,7 @@ class SensorModel:
     wheel_delay_s: float = 0.0
     runout: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0)  # e₁, φ₁ [rad], e₂, φ₂ [rad]
     pressure_delay_s: float = 0.0
+    fx_terms: tuple[tuple[float, float], ...] = ()  # the F_x channel's slot: (code, coeff)
 
     @classmethod
     def of(cls, params: RigParameters) -> SensorModel:
@@ -49,7 +51,9 @@ class SensorModel:
                    params.number(K.SENSORS_CROSSTALK_FX_PER_FZ),
                    params.number(K.SENSORS_WHEEL_SPEED_DELAY_S),
                    tuple(params.number(k) for k in RUNOUT_KEYS),
-                   params.number(K.SENSORS_PRESSURE_DELAY_S))
+                   params.number(K.SENSORS_PRESSURE_DELAY_S),
+                   tuple((params.number(code), params.number(coeff))
+                         for code, coeff in K.FX_TERMS if params.number(coeff) != 0.0))
 
     @property
     def ripples(self) -> bool:
@@ -100,13 +104,33 @@ class SensorModel:
         return late(times_s, true_rad_s, self.wheel_delay_s)
 
     def longitudinal(self, true_fx_n: Value, true_fz_n: Value,
-                     rng: np.random.Generator | None = None) -> Value:
-        """Load-cell F_x channel reading [N]: F_x plus its crosstalk from F_z."""
-        return _noisy(true_fx_n + self.fx_per_fz * true_fz_n, self.force_noise_n, rng)
+                     rng: np.random.Generator | None = None,
+                     time_s: float | np.ndarray = 0.0) -> Value:
+        """Load-cell F_x channel reading [N]: F_x plus its crosstalk from F_z and its generic
+        slot (``time_s``: since the run's first sample)."""
+        read = true_fx_n + self.fx_per_fz * true_fz_n + self.fx_slot(time_s, true_fz_n)
+        return _noisy(read, self.force_noise_n, rng)
 
-    def true_longitudinal(self, reading_n: Value, vertical_n: Value) -> Value:
-        """The F_x behind a load-cell reading (its crosstalk from F_z removed) [N]."""
-        return reading_n - self.fx_per_fz * vertical_n
+    def true_longitudinal(self, reading_n: Value, vertical_n: Value,
+                          time_s: float | np.ndarray = 0.0) -> Value:
+        """The F_x behind a load-cell reading (its crosstalk from F_z and its slot removed)
+        [N]."""
+        return reading_n - self.fx_per_fz * vertical_n - self.fx_slot(time_s, vertical_n)
+
+    def fx_slot(self, time_s: float | np.ndarray, vertical_n: Value) -> Value:
+        """What the F_x channel's generic slot adds to its reading [N]: Σ c_k φ_k(F_z, t),
+        ``model.basis``'s, ``time_s`` since the run's first sample (0: no term)."""
+        if not self.fx_terms:
+            none: Any = 0.0  # a float for arrays too: adds nothing, not even to a NaN's place
+            return none
+        load = np.atleast_1d(np.asarray(vertical_n, dtype=float))
+        signals = np.zeros((load.size, basis.N_SIGNALS))
+        signals[:, basis.LOAD] = load
+        signals[:, basis.RUN_TIME] = np.broadcast_to(time_s, load.shape)
+        total = sum(coeff * basis.term_values(round(code), signals)
+                    for code, coeff in self.fx_terms)
+        added: Any = total if np.ndim(vertical_n) else float(total[0])
+        return added
 
     def true_pressure(self, reading_pa: Value) -> Value:
         """The brake pressure behind a transducer reading (the offset removed) [Pa]."""

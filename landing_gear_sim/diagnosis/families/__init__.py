@@ -47,6 +47,7 @@ REGISTRY: tuple[Family, ...] = tuple(sorted((
     equation_terms.VALVE_FAMILY,
     equation_terms.WHEEL_FAMILY,
     equation_terms.TYRE_FAMILY,
+    equation_terms.FX_CHANNEL_FAMILY,
     equation_terms.FLYWHEEL_FAMILY,
     equation_terms.LOADING_FAMILY,
 ), key=lambda f: f.rank))

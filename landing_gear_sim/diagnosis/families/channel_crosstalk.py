@@ -18,7 +18,7 @@ import numpy as np
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
-from landing_gear_sim.diagnosis.consistency import FORCE_FLOOR_N, Relation, free_rolling_excess
+from landing_gear_sim.diagnosis.consistency import FORCE_FLOOR_N, Relation
 from landing_gear_sim.diagnosis.equation_library import flywheel_carries
 from landing_gear_sim.diagnosis.families.base import (
     DECIMATE,
@@ -94,7 +94,7 @@ def select_terms(runs: Sequence[ClassifiedRun], braking: Sequence[br.Braking],
     consistency floor."""
     excess, columns = [], []
     for b in braking:
-        mask, y = free_rolling_excess(b, params)
+        mask, y = br.free_rolling_excess(b, params)
         excess.append(y[::DECIMATE])
         columns.append(_channels(b.run, mask))
     for run in runs:

@@ -17,6 +17,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import RunKind, Selector
 from landing_gear_sim.diagnosis import equation_library as eq
 from landing_gear_sim.diagnosis.catalogue import (
@@ -215,8 +216,53 @@ class ValveTerms(EquationTerms):
                       (-4e6, -1.5e6)),)
 
 
+class FxChannelTerms(EquationTerms):
+    """The load cell's F_x channel (rank 5, with the named crosstalk: the channels first,
+    since what they misread distorts every other relation). A term it keeps must show in
+    the flywheel's momentum balance too: the flywheel feels the true F_x, the channel reads
+    it wrong (a bearing's torque on the wheel, pushed by the tyre, breaks the free-rolling
+    relation alike; U06's drift had been named a wheel term)."""
+
+    name = "fx_channel_equation"
+    library = eq.FX_CHANNEL
+    rank = 5
+    also_breaks = (Relation.FREE_ROLLING, Relation.NO_CONTACT)
+    free = (K.BRAKE_GAIN_N_M_PER_PA, K.FLYWHEEL_INERTIA_KG_M2, K.DRAG_COEFF_N_S2_PER_M2,
+            *FRICTION)
+    channels = (*WHEEL, "flywheel_speed_rad_s")
+    hidden = (Hidden("fx_drift", "F_x channel", lambda rng, datasheet: {
+        K.FX_TERMS[0][0]: float(basis.factor_code(basis.RUN_TIME, basis.IDENTITY)),
+        K.FX_TERMS[0][1]: rng.uniform(20.0, 60.0)}, K.FX_TERMS[0][1], "t", TOLERANCE),)
+
+    def propose(self, evidence: Evidence) -> list[Proposal]:
+        if not any(evidence.violated(r) for r in self.relations):
+            return []
+        chosen = [s for s in self.library.select(evidence.campaign, evidence.model)
+                  if _flywheel_reads(evidence, s)]
+        return [p for terms in _alternatives(chosen)
+                if (p := self._proposal(evidence, terms)) is not None]
+
+
+def _flywheel_reads(evidence: Evidence, selected: Selected) -> bool:
+    """Whether the flywheel's balance carries the channel's term too (at least half of it,
+    the same way)."""
+    code = selected.term.code
+    if code is None:
+        return False
+
+    def values(b: br.Braking) -> np.ndarray:
+        measured = np.zeros((b.time_s.size, basis.N_SIGNALS))
+        measured[:, basis.LOAD] = b.run.vertical_load_n
+        measured[:, basis.RUN_TIME] = br.run_time_s(b.run)
+        return basis.term_values(code, measured)
+
+    carried, _ = eq.flywheel_carries(evidence.braking, evidence.model, values)
+    return carried * selected.value > 0 and abs(carried) >= abs(selected.value) / 2
+
+
 VALVE_FAMILY = ValveTerms()
 WHEEL_FAMILY = WheelTerms()
 FLYWHEEL_FAMILY = FlywheelTerms()
 LOADING_FAMILY = LoadingTerms()
 TYRE_FAMILY = TyreTerms()
+FX_CHANNEL_FAMILY = FxChannelTerms()

@@ -22,6 +22,12 @@ key parameter in tolerance (issue 14: right family with held-out gain >= 80 %). 
 another rate, a counting encoder, a noisy quantised current, a dropout; see
 ``landing_gear_sim.calibration.logger``).
 
+Effects no family or slot term is (``OUTSIDE``, issue 41): laws outside every equation's
+library — two kinds per equation with a generic slot (the wheel's, the tyre's, the loading
+device's, the F_x channel's), drawn here through the plant's generic slots; right when
+discovered in the equation with a held-out gain (no value: no term of the library is the
+law). ``--causes`` names them like the others.
+
 Data the project did not make: the campaigns under ``../shared/data/independent/`` (or
 ``--independent DIR``; skipped when absent), judged against their ``truth.json``
 (``bench/independent.py``). Both parts end with a confusion matrix (truth × verdict) and
@@ -50,6 +56,8 @@ from landing_gear_sim.diagnosis.diagnose import Diagnosis, diagnose
 from landing_gear_sim.diagnosis.families import HIDDEN, REGISTRY, Hidden
 from landing_gear_sim.diagnosis.families.equation_terms import EquationTerms
 from landing_gear_sim.diagnosis.scoring import HELD_OUT_THRESHOLD
+from landing_gear_sim.model import basis
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters, load_parameters
 from msg_tools.io import read_campaign, read_runs
 
@@ -123,6 +131,51 @@ def _hidden_case(hidden: Hidden) -> Case:
 FAMILIES: dict[str, Case] = {name: _hidden_case(hidden) for name, (_, hidden) in HIDDEN.items()}
 
 
+def _slot(keys: tuple[tuple[str, str], ...], code: int, span: tuple[float, float]) -> Draw:
+    """A draw of one term of a generic slot: basis function ``code``, coefficient in
+    ``span``."""
+    return lambda rng, datasheet: {keys[0][0]: float(code), keys[0][1]: rng.uniform(*span)}
+
+
+def _product(first: tuple[int, int], second: tuple[int, int]) -> int:
+    return basis.product_code(basis.factor_code(*first), basis.factor_code(*second))
+
+
+# effects no family or slot term is (issue 41): laws outside every library's exact terms,
+# drawn here, through the plant's generic slots (the code under test never imports this);
+# right when the term is discovered in the equation, with a held-out gain
+OUTSIDE: dict[str, tuple[str, Draw]] = {
+    # pads that drag once applied, more at speed: [braked before] + ω·[braked before]
+    "wheel_drag_rising": ("wheel", lambda rng, d: {
+        K.WHEEL_TERMS[0][0]: float(basis.factor_code(basis.BRAKE_ENERGY, basis.STEP)),
+        K.WHEEL_TERMS[0][1]: rng.uniform(80.0, 160.0),
+        K.WHEEL_TERMS[1][0]: float(_product((basis.OMEGA, basis.IDENTITY),
+                                            (basis.BRAKE_ENERGY, basis.STEP))),
+        K.WHEEL_TERMS[1][1]: rng.uniform(0.1, 0.4)}),
+    # a seal that rubs while the brake is pressed: ω·[P > 0.5 bar]
+    "wheel_seal_pressed": ("wheel", _slot(K.WHEEL_TERMS, _product(
+        (basis.OMEGA, basis.IDENTITY), (basis.PRESSURE, basis.STEP)), (0.6, 1.2))),
+    # a cylinder that leaks faster at speed: √v·t_c
+    "load_leak_speed": ("loading device", _slot(K.LOADING_TERMS, _product(
+        (basis.SPEED, basis.SIGNED_ROOT), (basis.CONTACT_TIME, basis.IDENTITY)), (10.0, 25.0))),
+    # a cylinder whose leak grows with the square root of the time since contact: √t_c·v
+    "load_leak_root": ("loading device", _slot(K.LOADING_TERMS, _product(
+        (basis.SPEED, basis.IDENTITY), (basis.CONTACT_TIME, basis.SIGNED_ROOT)), (2.0, 5.0))),
+    # a friction falling with the square of the speed: μ_B·v²
+    "tyre_speed_squared": ("tyre", _slot(K.TYRE_TERMS, _product(
+        (basis.CURVE, basis.IDENTITY), (basis.SPEED, basis.SQUARE)), (-6e-5, -3e-5))),
+    # a peak that sharpens at speed: μ_B²·v
+    "tyre_peak_speed": ("tyre", _slot(K.TYRE_TERMS, _product(
+        (basis.CURVE, basis.SQUARE), (basis.SPEED, basis.IDENTITY)), (-0.012, -0.006))),
+    # a load cell's zero that drifts in proportion to the load it carries: √t·F_z
+    "fx_drift_load": ("F_x channel", _slot(K.FX_TERMS, _product(
+        (basis.RUN_TIME, basis.SIGNED_ROOT), (basis.LOAD, basis.IDENTITY)), (1e-3, 3e-3))),
+    # a load cell that bends with the load more the longer it runs: F_z²·t
+    "fx_bend_time": ("F_x channel", _slot(K.FX_TERMS, _product(
+        (basis.LOAD, basis.SIGNED_SQUARE), (basis.RUN_TIME, basis.IDENTITY)), (4e-8, 1e-7))),
+}
+
+
 def random_logger(rng: np.random.Generator) -> Logger:
     """A logger with realities drawn at random (each with probability REALITY)."""
     on = rng.random(4) < REALITY
@@ -143,6 +196,8 @@ def run_case(cause: str | None, seed: int, datasheet: RigParameters, light: bool
     key-parameter error)."""
     rng = np.random.default_rng(seed)
     rig = rig_like(datasheet, rng)
+    if cause in OUTSIDE:
+        return _outside(cause, rig, rng, seed, datasheet, realities)
     case = (CASES | FAMILIES).get(cause) if cause else None
     if case is not None:
         rig = rig.replace(case.draw(rng, datasheet), "hidden effect")
@@ -167,6 +222,23 @@ def run_case(cause: str | None, seed: int, datasheet: RigParameters, light: bool
     if result.verdict != cause or not found:
         return False, result.verdict, math.nan
     return _within(case, found[0].parameters[_key(case, rig)], rig, result.verdict)
+
+
+def _outside(cause: str, rig: RigParameters, rng: np.random.Generator, seed: int,
+             datasheet: RigParameters, realities: bool) -> tuple[bool, str, float]:
+    """A campaign of an OUTSIDE effect: right when discovered in its equation with a
+    held-out gain (no value: the law is none of the library's terms)."""
+    equation, draw = OUTSIDE[cause]
+    rig = rig.replace(draw(rng, datasheet), "hidden effect")
+    logger = random_logger(np.random.default_rng([seed, 2])) if realities else None
+    with tempfile.TemporaryDirectory() as folder:
+        generate_campaign(Path(folder), rig, seed, logger=logger)
+        runs = read_campaign(Path(folder)).runs
+    result = diagnose(runs, datasheet)
+    first = result.findings[0] if result.findings else None
+    ok = (result.verdict == "discovered" and first is not None and first.family == equation
+          and first.held_out is not None and first.held_out < HELD_OUT_THRESHOLD)
+    return ok, _verdict(result), math.nan
 
 
 def _verdict(result: Diagnosis) -> str:
@@ -198,7 +270,9 @@ def case_task(cause: str | None, seed: int, light: bool = False, realities: bool
     started = time.perf_counter()
     ok, verdict, error = run_case(cause, seed, load_parameters(), light, realities)
     truth = cause or "none"
-    if truth in FAMILIES:
+    if truth in OUTSIDE:
+        truth = f"discovered {OUTSIDE[truth][0]} ({truth})"
+    elif truth in FAMILIES:
         family = FAMILIES[truth].family
         truth = f"discovered {family}" + (f" ({truth})" if family != truth else "")
     return {"cause": truth, "seed": str(seed),
@@ -279,7 +353,8 @@ def report(title: str, rows: list[dict]) -> None:
 
 EQUATION_CASES: dict[str, str] = {
     f"discovered {h.family} ({h.name})": h.family
-    for f in REGISTRY if isinstance(f, EquationTerms) for h in f.hidden}
+    for f in REGISTRY if isinstance(f, EquationTerms) for h in f.hidden} | {
+    f"discovered {equation} ({name})": equation for name, (equation, _) in OUTSIDE.items()}
 """Journal truths of the equations' hidden effects -> the equation to name."""
 
 
@@ -305,8 +380,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--per-cause", type=int, default=3)
     parser.add_argument("--nulls", type=int, default=5)
-    parser.add_argument("--causes", default=",".join([*CASES, *FAMILIES]),
-                        help="catalogue causes and out-of-catalogue families (default: all)")
+    parser.add_argument("--causes", default=",".join([*CASES, *FAMILIES, *OUTSIDE]),
+                        help="catalogue causes, out-of-catalogue families and effects outside "
+                             "every library (OUTSIDE) (default: all)")
     parser.add_argument("--seed", type=int, default=1000)
     parser.add_argument("--scheduler", help="a running Dask scheduler (default: local)")
     parser.add_argument("--workers", type=int, help="local cluster: worker processes")

@@ -18,7 +18,7 @@ relation (:class:`~.relations.Relation`) is then violated, and the equation's fa
 from __future__ import annotations
 
 import abc
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
 
@@ -38,7 +38,6 @@ from landing_gear_sim.diagnosis.selection import (
     basis_terms,
     fit_terms,
     floor_of,
-    ordinary_fit,
     significant,
     term_columns,
     variable,
@@ -442,18 +441,3 @@ LIBRARIES: tuple[Library[Any], ...] = (VALVE, WHEEL, TYRE, FLYWHEEL, LOADING, FX
 def equation_checks(campaign: Campaign, params: RigParameters) -> list[Check]:
     """Each library's relation over ``campaign`` under ``params``."""
     return [c for lib in LIBRARIES if (c := lib.check(campaign, params)) is not None]
-
-
-def flywheel_carries(braking: Sequence[br.Braking], params: RigParameters,
-                     values: Callable[[br.Braking], np.ndarray]) -> tuple[float, float]:
-    """How much of ``values`` (a signal of a braking run) the measured F_x carries that the
-    flywheel does not feel: its coefficient in the flywheel's balance error, and its t
-    (0, 0: no run to tell). A channel's error shows wherever the channel is read; a torque
-    on the wheel (a bearing's) does not reach the flywheel's balance."""
-    carried = (Term[br.Braking]("", "", "", 0.0, lambda b, _: values(b)),)
-    rows = [r for b in braking if (r := FLYWHEEL.rows(b, params, carried)) is not None]
-    if not rows:
-        return 0.0, 0.0
-    coef, t = ordinary_fit(np.vstack([np.hstack([r.terms, r.owned]) for r in rows]),
-                           np.concatenate([r.error for r in rows]))
-    return float(coef[0]), float(t[0])

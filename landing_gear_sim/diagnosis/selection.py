@@ -175,11 +175,13 @@ def _residual(target: np.ndarray, design: np.ndarray) -> float:
 
 def _alike(x: np.ndarray, owned: np.ndarray, column: int, apart: Sequence[int]) -> list[int]:
     """The columns left out as not told apart that repeat ``column`` alone (beside the owned
-    ones) within ALIKE: the samples cannot say which of them the error holds; a fit of the
-    rig's runs can ('[braked before]' and '[P > 0.5 bar]' part where an oscillating brake
-    releases)."""
-    return [other for other in sorted(set(range(x.shape[1])) - set(apart))
-            if _residual(x[:, other], np.hstack([owned, x[:, [column]]])) <= ALIKE]
+    ones) within ALIKE, the closest first: the samples cannot say which of them the error
+    holds; a fit of the rig's runs can ('[braked before]' and '[P > 0.5 bar]' part where an
+    oscillating brake releases)."""
+    design = np.hstack([owned, x[:, [column]]])
+    near = {other: _residual(x[:, other], design)
+            for other in set(range(x.shape[1])) - set(apart)}
+    return sorted((o for o, r in near.items() if r <= ALIKE), key=lambda o: (near[o], o))
 
 
 def _joint_z(kept: np.ndarray, owned: np.ndarray, y: np.ndarray) -> float:

@@ -19,7 +19,6 @@ from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
 from landing_gear_sim.diagnosis.consistency import FORCE_FLOOR_N, Relation
-from landing_gear_sim.diagnosis.equation_library import flywheel_carries
 from landing_gear_sim.diagnosis.families.base import (
     DECIMATE,
     Evidence,
@@ -28,6 +27,7 @@ from landing_gear_sim.diagnosis.families.base import (
     Proposal,
     term_candidate,
 )
+from landing_gear_sim.diagnosis.flywheel_reads import flywheel_carries
 from landing_gear_sim.diagnosis.sparse import sparse_coefficients
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters

@@ -35,6 +35,7 @@ from landing_gear_sim.diagnosis.families.base import (
     Proposal,
     term_candidate,
 )
+from landing_gear_sim.diagnosis.flywheel_reads import flywheel_carries
 from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.diagnosis.selection import Selected
 from landing_gear_sim.diagnosis.terms import BasisTerm, coefficient_unit, term_of
@@ -119,7 +120,7 @@ class EquationTerms(Family):
         return self.library.law(written, params)
 
 
-ALTERNATIVES = 2  # terms the samples could not tell apart, tried each in its place
+ALTERNATIVES = 1  # terms the samples could not tell apart, tried in its place (each costs a fit)
 
 
 def _alternatives(chosen: list[Selected]) -> list[list[Selected]]:
@@ -256,7 +257,7 @@ def _flywheel_reads(evidence: Evidence, selected: Selected) -> bool:
         measured[:, basis.RUN_TIME] = br.run_time_s(b.run)
         return basis.term_values(code, measured)
 
-    carried, _ = eq.flywheel_carries(evidence.braking, evidence.model, values)
+    carried, _ = flywheel_carries(evidence.braking, evidence.model, values)
     return carried * selected.value > 0 and abs(carried) >= abs(selected.value) / 2
 
 

@@ -133,8 +133,8 @@ def judge_unseen(result: dict, equation: str) -> tuple[bool, str]:
     first = findings[0] if findings else {}
     if result["verdict"] == "discovered" and first.get("family") == equation:
         return True, f"discovered {equation}: {first.get('term', '')}"
+    if result["verdict"] == "discovered":
+        return False, f"discovered {first.get('family')}: {first.get('term', '')}"
     if any(f["cause"] == "unexplained" and f.get("equation") == equation for f in findings):
         return False, f"unexplained, naming the {equation}"
-    if result["verdict"] == "discovered":
-        return False, f"discovered in the {first.get('family')}: {first.get('term', '')}"
     return False, result["verdict"]

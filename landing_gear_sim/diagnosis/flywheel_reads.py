@@ -28,3 +28,12 @@ def flywheel_carries(braking: Sequence[br.Braking], params: RigParameters,
     coef, t = ordinary_fit(np.vstack([np.hstack([r.terms, r.owned]) for r in rows]),
                            np.concatenate([r.error for r in rows]))
     return float(coef[0]), float(t[0])
+
+
+def flywheel_reads(braking: Sequence[br.Braking], params: RigParameters,
+                   values: Callable[[br.Braking], np.ndarray], coefficient: float) -> bool:
+    """Whether the flywheel's balance carries ``coefficient`` of ``values`` as the F_x
+    channel does (at least half of it, the same way): a channel's error, not a torque on the
+    wheel."""
+    carried, _ = flywheel_carries(braking, params, values)
+    return carried * coefficient > 0 and abs(carried) >= abs(coefficient) / 2

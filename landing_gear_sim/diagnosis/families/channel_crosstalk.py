@@ -27,7 +27,7 @@ from landing_gear_sim.diagnosis.families.base import (
     Proposal,
     term_candidate,
 )
-from landing_gear_sim.diagnosis.flywheel_reads import flywheel_carries
+from landing_gear_sim.diagnosis.flywheel_reads import flywheel_reads as carries
 from landing_gear_sim.diagnosis.sparse import sparse_coefficients
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
@@ -115,9 +115,7 @@ def flywheel_reads(evidence: Evidence, term: ChannelTerm, fraction: float) -> bo
     ``term`` too (at least half of it, the same way). A channel's error is read wherever the
     channel is; a torque on the wheel (a bearing's) also breaks the free-rolling relation,
     but the flywheel feels what the channel reads and its balance holds."""
-    carried, _ = flywheel_carries(evidence.braking, evidence.model,
-                                  lambda b: term.values(b.run))
-    return carried * fraction > 0 and abs(carried) >= abs(fraction) / 2
+    return carries(evidence.braking, evidence.model, lambda b: term.values(b.run), fraction)
 
 
 def _channels(run: ClassifiedRun, mask: np.ndarray) -> np.ndarray:

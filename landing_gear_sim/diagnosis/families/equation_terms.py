@@ -35,7 +35,7 @@ from landing_gear_sim.diagnosis.families.base import (
     Proposal,
     term_candidate,
 )
-from landing_gear_sim.diagnosis.flywheel_reads import flywheel_carries
+from landing_gear_sim.diagnosis.flywheel_reads import flywheel_reads
 from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.diagnosis.selection import Selected
 from landing_gear_sim.diagnosis.terms import BasisTerm, coefficient_unit, term_of
@@ -257,8 +257,7 @@ def _flywheel_reads(evidence: Evidence, selected: Selected) -> bool:
         measured[:, basis.RUN_TIME] = br.run_time_s(b.run)
         return basis.term_values(code, measured)
 
-    carried, _ = flywheel_carries(evidence.braking, evidence.model, values)
-    return carried * selected.value > 0 and abs(carried) >= abs(selected.value) / 2
+    return flywheel_reads(evidence.braking, evidence.model, values, selected.value)
 
 
 VALVE_FAMILY = ValveTerms()

@@ -26,7 +26,9 @@ from landing_gear_sim.diagnosis.terms import (
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model import scenario as sc
+from landing_gear_sim.model.actuator import actuator_pressure
 from landing_gear_sim.model.integrate import simulate
+from landing_gear_sim.model.reference import reference_solution
 from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.io import read_campaign
 
@@ -112,12 +114,14 @@ def _with_terms(params, slot: Slot, terms: list[tuple[int, float]]):
 def test_a_slot_of_codes_with_zero_coefficients_is_todays_arithmetic_to_the_bit(reference):
     codes = [(basis.factor_code(basis.OMEGA, basis.SIGN), 0.0),
              (basis.factor_code(basis.SLIP, basis.CUBE), 0.0)]
-    filled = _with_terms(_with_terms(_with_terms(reference, Slot.WHEEL, codes), Slot.TYRE,
-                                     codes), Slot.LOADING, codes)
+    filled = reference
+    for slot in (Slot.WHEEL, Slot.TYRE, Slot.LOADING, Slot.VALVE):
+        filled = _with_terms(filled, slot, codes)
     scenario = sc.constant_pressure_test(reference, 30e5)
     plain, empty = simulate(reference, scenario), simulate(filled, scenario)
     assert np.array_equal(plain.wheel_speed_rad_s, empty.wheel_speed_rad_s)
     assert np.array_equal(plain.vertical_load_n, empty.vertical_load_n)
+    assert np.array_equal(plain.pressure_pa, empty.pressure_pa)
 
 
 def test_pads_that_drag_once_applied_slow_the_wheel_only_after_the_brake_acted(reference):
@@ -130,6 +134,51 @@ def test_pads_that_drag_once_applied_slow_the_wheel_only_after_the_brake_acted(r
     assert np.array_equal(plain.wheel_speed_rad_s[:before], slowed.wheel_speed_rad_s[:before])
     assert slowed.time_s[-1] < plain.time_s[-1]
     assert slowed.drag_energy_j[-1] > plain.drag_energy_j[-1] + 150.0 * 100.0
+
+
+def _steps(reference, levels_a: list[float], hold_s: float = 1.0) -> np.ndarray:
+    return np.repeat(levels_a, round(hold_s * 1000))
+
+
+def test_a_valve_stiffer_at_pressure_answers_a_step_faster_high_than_low(reference):
+    """ω_n² (1 + c P) written in A(s)'s slot as c P·ΔP (the test draws c): the time to half
+    of a small step shrinks with the level it starts from; the plain valve's does not."""
+    c = float(np.random.default_rng(44).uniform(2e-7, 4e-7))
+    stiff = _with_terms(reference, Slot.VALVE, [(basis.product_code(
+        basis.factor_code(basis.PRESSURE, basis.IDENTITY),
+        basis.factor_code(basis.VALVE_ERROR, basis.IDENTITY)), c)])
+
+    def half_times_ms(params) -> list[int]:
+        out = []
+        for start, end in ((0.3, 0.4), (0.75, 0.85)):  # ~15 and ~50 bar
+            pressure = actuator_pressure(params, _steps(params, [start, end]), 1000.0)
+            half = 0.5 * (pressure[0] + pressure[-1])
+            out.append(int(np.argmax(pressure > half)) - 1000)
+        return out
+
+    low, high = half_times_ms(reference)
+    assert abs(high - low) <= 1
+    stiff_low, stiff_high = half_times_ms(stiff)
+    assert stiff_high <= stiff_low - 2 and stiff_low < low
+
+
+def test_the_reference_ode_follows_the_valves_slot_as_the_compiled_step_does(reference):
+    """The continuous equations and the plant's step read one law (`actuator.valve_slot`):
+    with a term in A(s) they agree as closely as without it, and the term moves both."""
+    code = basis.product_code(basis.factor_code(basis.PRESSURE, basis.IDENTITY),
+                              basis.factor_code(basis.VALVE_ERROR, basis.IDENTITY))
+    plain = reference  # no transport delay: the reference ODE models none
+    stiff = _with_terms(plain, Slot.VALVE, [(code, 3e-7)])
+    scenario = sc.Scenario("steps", _steps(plain, [0.0, 1.0, 2.0, 0.5], 0.5), 1000.0, False,
+                           0.0, 0.0, "actuator-only steps")
+    error = {}
+    for name, params in (("plain", plain), ("stiff", stiff)):
+        fast = simulate(params, scenario).pressure_pa
+        exact = reference_solution(params, scenario)["pressure_pa"]
+        error[name] = float(np.max(np.abs(fast - exact)))
+        moved = float(np.max(np.abs(exact - reference_solution(plain, scenario)["pressure_pa"])))
+    assert moved > 1e5
+    assert error["stiff"] < max(3 * error["plain"], 0.01 * moved)
 
 
 def test_a_leaking_cylinder_takes_load_off_in_proportion_to_the_time_since_contact(reference):
@@ -246,8 +295,9 @@ def test_the_diagnosis_contract_lists_each_generic_slots_library_as_composed():
     cells = [re.split(r"(?<!\\)\|", line) for line in page.splitlines()
              if line.startswith("| ")]
     rows = {c[1].strip(): "|".join(c) for c in cells if len(c) == 5}
-    for library in (eq.WHEEL, eq.TYRE, eq.LOADING, eq.FX_CHANNEL):
-        row = rows[str(library.equation)]
+    labels = {eq.VALVE_DYNAMICS: "valve (A(s), `diagnosis/valve_library.py`)"}
+    for library in (eq.WHEEL, eq.TYRE, eq.LOADING, eq.FX_CHANNEL, eq.VALVE_DYNAMICS):
+        row = rows[labels.get(library, str(library.equation))]
         symbols = {basis.SIGNALS[f // basis.FACTOR][0] for t in library.terms
                    for f in basis.factors(t.code or 0)}
         assert all(symbol in row for symbol in symbols), (library.equation, symbols)

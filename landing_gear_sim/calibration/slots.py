@@ -28,12 +28,14 @@ class Slot(str, enum.Enum):
     TYRE = "friction"
     LOADING = "loading"
     FX_CHANNEL = "sensors"
+    VALVE = "actuator"
 
     @property
     def keys(self) -> tuple[tuple[str, str], ...]:
         """Its (code, coefficient) keys."""
         return {"wheel": K.WHEEL_TERMS, "friction": K.TYRE_TERMS,
-                "loading": K.LOADING_TERMS, "sensors": K.FX_TERMS}[self.value]
+                "loading": K.LOADING_TERMS, "sensors": K.FX_TERMS,
+                "actuator": K.VALVE_TERMS}[self.value]
 
     def value_of(self, params: RigParameters, measured: np.ndarray) -> np.ndarray:
         """The slot of ``params`` at each row of ``measured`` (:func:`signals`)."""
@@ -52,6 +54,7 @@ SEES: dict[Slot, tuple[int, ...]] = {
     Slot.TYRE: (basis.SPEED, basis.LOAD, basis.SLIP, basis.CURVE),
     Slot.LOADING: (basis.SPEED, basis.CONTACT_TIME),
     Slot.FX_CHANNEL: (basis.LOAD, basis.RUN_TIME),
+    Slot.VALVE: (basis.PRESSURE, basis.PRESSURE_RATE, basis.VALVE_ERROR),
 }
 """The signals each equation's slot sees in the plant (``model.elements``)."""
 
@@ -71,7 +74,7 @@ def signals(time_s: np.ndarray, wheel_rad_s: np.ndarray, speed_m_s: np.ndarray,
     at the loaded radius, the wheel's angle integrated from the run's start, the time since
     the model's touch-down (0 before it), the model's friction curve at the slip."""
     radius = rolling_radius_at(params, load_n)
-    out = np.empty((time_s.size, basis.N_SIGNALS))
+    out = np.zeros((time_s.size, basis.N_SIGNALS))  # A(s)'s states: the valve's, not read here
     out[:, basis.OMEGA] = wheel_rad_s
     out[:, basis.SPEED] = speed_m_s
     out[:, basis.PRESSURE] = pressure_pa

@@ -1,26 +1,25 @@
 """Each equation of the rig with its library of terms, and its error (issues 29, 41).
 
 Every effect, catalogued or not, is a missing term in one of the rig's equations. For the
-valve's static map, the wheel's torque balance, the tyre's force law, the flywheel's
-momentum balance and the loading device's law, the error is computed from the measured
-signals under the model (the other equations' terms measured) over the samples that carry
-it: the actuator runs' settled ones for the valve, every braking run's thinned to the
-filter's bandwidth for the others. Each equation's library is the terms of its slot in the
-plant — the generic slots' basis functions composed with :mod:`~.terms`
-(``wheel.term_*``, ``friction.term_*``, ``loading.term_*``), the named ones' terms
-(``actuator.extra_*``, ``flywheel.extra_*``) — beside the terms whose coefficients the
-calibration owns (the map's 1, e, e²; k_b P in the wheel's; the curve's ϑ; the flywheel's
-mass and drag; the lift). :mod:`~.selection` picks the terms the error needs; the equation's
-relation (:class:`~.relations.Relation`) is then violated, and the equation's family
+valve's static map and A(s) (:mod:`~.valve_library`), the wheel's torque balance, the
+tyre's force law, the flywheel's momentum balance, the loading device's law and the F_x
+channel, the error is computed from the measured signals under the model (the other
+equations' terms measured) over the samples that carry it: the actuator runs' for the valve,
+every braking run's thinned to the filter's bandwidth for the others. Each equation's
+library is the terms of its slot in the plant — the generic slots' basis functions composed
+with :mod:`~.terms` (``wheel.term_*``, ``friction.term_*``, ``loading.term_*``,
+``sensors.fx_term_*``, ``actuator.term_*``), the named ones' terms (``actuator.extra_*``,
+``flywheel.extra_*``) — beside the terms whose coefficients the calibration owns (the map's
+1, e, e²; k_b P in the wheel's; the curve's ϑ; the flywheel's mass and drag; the lift).
+:mod:`~.selection` picks the terms the error needs; the equation's relation
+(:class:`~.relations.Relation`) is then violated, and the equation's family
 (:mod:`~.families.equation_terms`) proposes them.
 """
 
 from __future__ import annotations
 
-import abc
 from collections.abc import Sequence
-from dataclasses import dataclass
-from typing import Any, Generic, TypeVar
+from typing import Any
 
 import numpy as np
 
@@ -30,20 +29,17 @@ from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.slots import Slot, seen
 from landing_gear_sim.diagnosis.catalogue import noise_std
 from landing_gear_sim.diagnosis.equations import Equation
-from landing_gear_sim.diagnosis.relations import Check, Relation
-from landing_gear_sim.diagnosis.selection import (
-    Rows,
-    Selected,
-    Term,
-    basis_terms,
-    fit_terms,
-    floor_of,
-    significant,
-    term_columns,
-    variable,
+from landing_gear_sim.diagnosis.library import (
+    BrakingLibrary,
+    Campaign,
+    Library,
+    about_run_mean,
+    thinned,
 )
-from landing_gear_sim.diagnosis.settled_valve import Settled, settled_valve
+from landing_gear_sim.diagnosis.relations import Check, Relation
+from landing_gear_sim.diagnosis.selection import Rows, Term, basis_terms, term_columns, variable
 from landing_gear_sim.diagnosis.terms import Shaped, Without
+from landing_gear_sim.diagnosis.valve_library import VALVE, VALVE_DYNAMICS
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
@@ -52,98 +48,7 @@ from landing_gear_sim.model.quantities import friction_coefficients, load_factor
 from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.units import display, signed
 
-EDGE_S = 0.5  # the zero-phase filter's ends are left out
 SETTLE_S = 0.5  # after the touch-down ramp, before the loading device's load is its law
-VALVE_RATE_HZ = 100.0  # a valve's settled samples are thinned to this: closer ones add little
-
-S = TypeVar("S")  # what a library reads one run's rows from: a braking run's signals, ...
-
-
-@dataclass(frozen=True)
-class Campaign:
-    """What the libraries read: a campaign's runs, and its braking runs' filtered signals
-    under the model (prepared once)."""
-
-    runs: Sequence[ClassifiedRun]
-    braking: Sequence[br.Braking]
-
-
-class Library(abc.ABC, Generic[S]):
-    """One equation's generic slot (see the module docstring): its ``terms``, the relation
-    that says whether its error needs them, the unit of its error, the runs it reads
-    (``phase``, in words), and the sign its terms are written with in its law (−1: they
-    oppose, as a bearing's friction)."""
-
-    equation: Equation
-    relation: Relation
-    terms: tuple[Term[S], ...]
-    unit: str
-    phase: str
-    sign: float = -1.0
-    slot: Slot | None = None  # the generic slot its basis terms take places in
-
-    @abc.abstractmethod
-    def sources(self, campaign: Campaign, params: RigParameters) -> list[S]:
-        """What each run that carries the equation's error gives to read it from."""
-
-    @abc.abstractmethod
-    def rows(self, source: S, params: RigParameters,
-             terms: Sequence[Term[S]] | None = None) -> Rows | None:
-        """The regression rows of one run on ``terms`` (default: the library's; None: the
-        run has no samples to give)."""
-
-    @abc.abstractmethod
-    def law(self, written: str, params: RigParameters) -> str:
-        """The equation with its slot's terms ``written`` out in it."""
-
-    def select(self, campaign: Campaign, params: RigParameters) -> list[Selected]:
-        """The library's terms the equation's error needs under ``params``."""
-        rows = self._rows(campaign, params)
-        fitted = fit_terms(self.terms, rows) if rows else None
-        return fitted.selected if fitted and significant(fitted, rows) else []
-
-    def check(self, campaign: Campaign, params: RigParameters) -> Check | None:
-        """The equation's relation over the campaign: what its terms explain jointly (None:
-        no run to tell)."""
-        rows = self._rows(campaign, params)
-        fitted = fit_terms(self.terms, rows) if rows else None
-        if fitted is None or not fitted.selected:
-            return None
-        named = ", ".join(s.term.name for s in fitted.selected)
-        return Check(self.relation, "campaign", f"{self.phase}, {named}", fitted.effect,
-                     fitted.effect / max(fitted.z, 1e-12), floor_of(rows),
-                     self.unit)
-
-    def _rows(self, campaign: Campaign, params: RigParameters) -> list[Rows]:
-        return [r for s in self.sources(campaign, params)
-                if (r := self.rows(s, params)) is not None]
-
-
-class BrakingLibrary(Library[br.Braking]):
-    """A library read from the braking runs."""
-
-    phase = "braking runs"
-
-    def sources(self, campaign: Campaign, params: RigParameters) -> list[br.Braking]:
-        return list(campaign.braking)
-
-
-
-def _thinned(mask: np.ndarray, rate_hz: float) -> np.ndarray:
-    """The indices of ``mask`` away from the filter's ends, one per half period of its
-    cut-off (the signals are low-passed there: closer samples carry no news)."""
-    index = np.flatnonzero(mask)
-    edge = round(EDGE_S * rate_hz)
-    index = index[(index > edge) & (index < mask.size - edge)]
-    return index[::max(1, round(rate_hz / (2 * br.FILTER_HZ)))]
-
-
-def _about_run_mean(error: np.ndarray, terms: np.ndarray, owned: np.ndarray, scale: float
-                    ) -> Rows:
-    """Rows about their run's mean (each run's own constant: a static load, a speed's
-    start)."""
-    return Rows(error - error.mean(), terms - terms.mean(axis=0), owned - owned.mean(axis=0),
-                scale)
 
 
 WHEEL_TERMS = (
@@ -172,7 +77,7 @@ class WheelLibrary(BrakingLibrary):
 
     def rows(self, b: br.Braking, params: RigParameters,
              terms: Sequence[Term[br.Braking]] | None = None) -> Rows | None:
-        index = _thinned(br.steady_braking_samples(b) | br.free_rolling(b), b.run.rate_hz)
+        index = thinned(br.steady_braking_samples(b) | br.free_rolling(b), b.run.rate_hz)
         if index.size < 20:
             return None
         b = br.in_step(b, params)  # a late pressure channel's error is its own family's
@@ -203,7 +108,7 @@ class FlywheelLibrary(BrakingLibrary):
 
     def rows(self, b: br.Braking, params: RigParameters,
              terms: Sequence[Term[br.Braking]] | None = None) -> Rows | None:
-        index = _thinned(b.speed_m_s > 1.0 + params.number(K.RIG_TEST_STOP_SPEED_M_S),
+        index = thinned(b.speed_m_s > 1.0 + params.number(K.RIG_TEST_STOP_SPEED_M_S),
                          b.run.rate_hz)
         if index.size < 20:
             return None
@@ -214,7 +119,7 @@ class FlywheelLibrary(BrakingLibrary):
         impulse = np.cumsum(resisting * dt)
         columns = [np.cumsum(variable(t, b, params) * dt) for t in terms or self.terms]
         owned = [speed, np.cumsum(speed * speed * dt)]
-        return _about_run_mean((el.translational_mass(p) * speed + impulse)[index],
+        return about_run_mean((el.translational_mass(p) * speed + impulse)[index],
                                np.column_stack(columns)[index], np.column_stack(owned)[index],
                                float(np.std(impulse[index])))
 
@@ -251,7 +156,7 @@ class LoadingLibrary(BrakingLibrary):
             return None
         touchdown = b.time_s[np.argmax(loaded)]
         settled = b.time_s > touchdown + params.number(K.LOADING_TOUCHDOWN_RAMP_S) + SETTLE_S
-        index = _thinned(settled & loaded, b.run.rate_hz)
+        index = thinned(settled & loaded, b.run.rate_hz)
         if index.size < 20:
             return None
         speed = b.speed_m_s[index]
@@ -262,7 +167,7 @@ class LoadingLibrary(BrakingLibrary):
         # falls with v² is followed τ late, 120 N at 60 m/s braking at 8 m/s²)
         tau = params.number(K.LOADING_SERVO_TIME_CONSTANT_S)
         setpoint = b.load + tau * np.gradient(b.load, b.time_s)
-        return _about_run_mean(setpoint[index] + taken,
+        return about_run_mean(setpoint[index] + taken,
                                -term_columns(terms or self.terms, b, params, index, measured),
                                (speed * speed)[:, None], float(np.mean(b.load[index])))
 
@@ -385,57 +290,13 @@ def _slip_noise(b: br.Braking, index: np.ndarray) -> np.ndarray:
     return filtered / np.maximum(b.wheel[index], 1.0)
 
 
-class ValveLibrary(Library[Settled]):
-    """The valve's static map P = k1 e + k2 e² + k3 e³, e = I − I0: a map that bends
-    beyond the quadratic the calibration fits (flow forces, a spring's progression). Its
-    error is the measured pressure's excess over the model's on an actuator run's settled
-    samples (:func:`~.settled_valve.settled_valve`), where A(s) has settled; the terms the
-    calibration owns there are the map's (k1, k2, and the dead-band's shift: a constant)."""
-
-    equation = Equation.VALVE
-    relation = Relation.VALVE_MAP
-    unit = "Pa"
-    phase = "actuator runs, settled"
-    sign = 1.0
-    terms = (Term(K.ACTUATOR_EXTRA_MAP_PA_PER_A3, "·e³", "Pa/A^3", 2e7,
-                  lambda v, params: _excess(v, params) ** 3),)
-
-    def sources(self, campaign: Campaign, params: RigParameters) -> list[Settled]:
-        return [v for r in campaign.runs if not r.braking
-                and (v := settled_valve(r, params)) is not None]
-
-    def rows(self, source: Settled, params: RigParameters,
-             terms: Sequence[Term[Settled]] | None = None) -> Rows | None:
-        index = np.flatnonzero(source.settled)[::max(1, round(source.rate_hz / VALVE_RATE_HZ))]
-        if index.size < 20:
-            return None
-        gain = params.number(K.ACTUATOR_GAIN)
-        excess = _excess(source, params)[index]
-        owned = gain * np.column_stack([np.ones_like(excess), excess, excess * excess])
-        return Rows(source.residual_pa[index],
-                    gain * np.column_stack([variable(t, source, params)[index]
-                                            for t in terms or self.terms]),
-                    owned, float(np.mean(source.model_pa[index])))
-
-    def law(self, written: str, params: RigParameters) -> str:
-        k1, k2 = (display(params.number(k), unit, ".3g") for k, unit in (
-            (K.ACTUATOR_MAP_K1_PA_PER_A, "Pa/A"), (K.ACTUATOR_MAP_K2_PA_PER_A2, "Pa/A^2")))
-        return f"P_static = {k1}·e + {k2}·e² {written}"
-
-
-def _excess(valve: Settled, params: RigParameters) -> np.ndarray:
-    """The map's variable e = I − I0 ≥ 0 [A] of the current the valve was fed."""
-    return el.valve_excess(valve.current_a, params.number(K.ACTUATOR_MAX_CURRENT_A),
-                           params.number(K.ACTUATOR_DEADBAND_CURRENT_A))
-
-
-VALVE = ValveLibrary()
 WHEEL = WheelLibrary()
 TYRE = TyreLibrary()
 FLYWHEEL = FlywheelLibrary()
 LOADING = LoadingLibrary()
 FX_CHANNEL = FxChannelLibrary()
-LIBRARIES: tuple[Library[Any], ...] = (VALVE, WHEEL, TYRE, FLYWHEEL, LOADING, FX_CHANNEL)
+LIBRARIES: tuple[Library[Any], ...] = (VALVE, VALVE_DYNAMICS, WHEEL, TYRE, FLYWHEEL, LOADING,
+                                       FX_CHANNEL)
 
 
 def equation_checks(campaign: Campaign, params: RigParameters) -> list[Check]:

@@ -36,6 +36,7 @@ class Relation(str, enum.Enum):
     VALVE_MAP = "valve settles on its quadratic static map"
     TYRE_LAW = "tyre follows its friction curve"
     FX_CHANNEL = "F_x channel reads F_x where it is known"
+    VALVE_DYNAMICS = "valve follows A(s) between its levels"
 
     def __str__(self) -> str:
         return self.value
@@ -69,6 +70,7 @@ _WHERE = {
     "VALVE_MAP": ("valve", "pressure_pa"),
     "TYRE_LAW": ("tyre", "wheel_speed_rad_s"),
     "FX_CHANNEL": ("F_x channel", "longitudinal_force_n"),
+    "VALVE_DYNAMICS": ("valve", "pressure_pa"),
 }
 @dataclass(frozen=True)
 class Check:

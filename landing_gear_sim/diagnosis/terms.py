@@ -80,6 +80,18 @@ def coefficient_unit(equation_unit: str, term: BasisTerm) -> str:
     """The unit of a coefficient of ``term`` in an equation of ``equation_unit``."""
     if term.unit == "-":
         return equation_unit
+    base, _, power = term.unit.partition("^")
+    if base == equation_unit and power:  # |ΔP|·ΔP in an equation in Pa: 1/Pa
+        left = 1.0 - float(power)
+        return _power(base, left) if left > 0 else f"1/{_power(base, -left)}"
+    factors = term.unit.split(" ")
+    if equation_unit in factors:  # P·ΔP in an equation in Pa: 1/Pa, not Pa/(Pa Pa)
+        factors.remove(equation_unit)
+        rest = " ".join(factors)
+        if "/" in rest and " " not in rest:
+            numerator, denominator = rest.split("/")
+            return f"{denominator}/{numerator}"
+        return f"1/{rest}" if " " not in rest else f"1/({rest})"
     per = f"({term.unit})" if " " in term.unit or "/" in term.unit else term.unit
     return f"{equation_unit}/{per}" if equation_unit != "-" else f"1/{per}"
 

@@ -6,6 +6,13 @@ space (:func:`second_order_system`) from which come the exact discretisation the
 plant steps (:func:`actuator_matrices`), the frequency response identification fits
 (:func:`second_order_response`) and the continuous equations of the reference solution.
 State: pressure [Pa] and its rate [Pa/s], driven by the static-map pressure [Pa].
+
+A(s) holds the valve's generic slot (``actuator.term_*``, ``model.basis``): a term
+Σ c_k φ_k(P, Ṗ, ΔP) [Pa] beside the static pressure it is driven by,
+P̈ = ω_n² (μ P_static + Σ c_k φ_k − P) − 2 ξ ω_n Ṗ, with ΔP = μ P_static − P: a spool
+that sticks (c sgn ΔP), a valve stiffer at pressure (c P·ΔP). It acts undelayed, held over
+a step at the mean of its values at the step's two ends, through the unit-gain input
+matrix.
 """
 
 from __future__ import annotations
@@ -17,6 +24,7 @@ import numpy as np
 import scipy.linalg
 from numba import njit
 
+from landing_gear_sim.model import basis
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import INDEX, RigParameters
@@ -26,6 +34,7 @@ _ACT_WN = INDEX[K.ACTUATOR_NATURAL_FREQUENCY_HZ]
 _ACT_ZETA = INDEX[K.ACTUATOR_DAMPING_RATIO]
 _ACT_DELAY = INDEX[K.ACTUATOR_DELAY_S]
 _BACKLASH = INDEX[K.ACTUATOR_BACKLASH_A]
+_VALVE_SLOT = INDEX[K.VALVE_TERMS[0][0]]
 PLAY = 2  # actuator state: pressure, rate, the current the valve sees, static pressures
 
 
@@ -65,6 +74,7 @@ def _zoh(a: np.ndarray, b: np.ndarray, span_s: float) -> tuple[np.ndarray, np.nd
 
 
 ACT_DELAY_STEPS = 8  # position of the whole-step delay in the actuator matrices
+ACT_SLOT = 9  # ... and of the slot's input matrix over a whole step (2 entries)
 
 
 def actuator_matrices(params_vector: np.ndarray, step_s: float) -> np.ndarray:
@@ -73,8 +83,9 @@ def actuator_matrices(params_vector: np.ndarray, step_s: float) -> np.ndarray:
     With the delay d = (m + f)·h, the input seen over step k is u_{k−m−1} for f·h,
     then u_{k−m} for (1−f)·h, so x_{k+1} = Φ_h x_k + G0 u_{k−m} + G1 u_{k−m−1} with
     G0 = Γ_{(1−f)h} and G1 = Φ_{(1−f)h} Γ_{fh}. Returns
-    ``[Φ00, Φ01, Φ10, Φ11, G0₀, G0₁, G1₀, G1₁, m]`` for the state (pressure [Pa],
-    rate [Pa/s]) driven by the static-map pressure.
+    ``[Φ00, Φ01, Φ10, Φ11, G0₀, G0₁, G1₀, G1₁, m, Γ₀, Γ₁]`` for the state (pressure [Pa],
+    rate [Pa/s]) driven by the static-map pressure; Γ = Γ_h of the unit-gain input, the
+    valve's slot's.
     """
     p = params_vector
     delay = float(p[_ACT_DELAY]) if p[el.HAS_ACTUATOR_DELAY] else 0.0
@@ -97,7 +108,8 @@ def _matrices(natural_frequency_hz: float, damping_ratio: float, gain: float, de
     else:
         phi_late, g0 = _zoh(a, b, (1.0 - fraction) * step_s)
         g1 = phi_late @ _zoh(a, b, fraction * step_s)[1]
-    return np.concatenate([phi.ravel(), g0, g1, [float(whole)]])
+    unit = _zoh(a, b / gain, step_s)[1] if gain != 0.0 else np.zeros(2)
+    return np.concatenate([phi.ravel(), g0, g1, [float(whole)], unit])
 
 
 @njit(cache=True)
@@ -133,15 +145,40 @@ def actuator_step(p, matrices, xa, current_a):
         return xa[0]
     m = matrices
     x0, x1 = xa[0], xa[1]
-    xa[0] = m[0] * x0 + m[1] * x1 + m[4] * newer + m[6] * older
-    xa[1] = m[2] * x0 + m[3] * x1 + m[5] * newer + m[7] * older
+    y0 = m[0] * x0 + m[1] * x1 + m[4] * newer + m[6] * older
+    y1 = m[2] * x0 + m[3] * x1 + m[5] * newer + m[7] * older
+    # the slot's term held over the step at the mean of its ends (Heun): held at the step's
+    # start it lags half a step, 5 % of what a stiffening term moves
+    first_slot = valve_slot(p, x0, x1, newer)
+    late = valve_slot(p, y0 + m[ACT_SLOT] * first_slot, y1 + m[ACT_SLOT + 1] * first_slot,
+                      newer)
+    slot = 0.5 * (first_slot + late)
+    xa[0] = y0 + m[ACT_SLOT] * slot
+    xa[1] = y1 + m[ACT_SLOT + 1] * slot
     return xa[0]
+
+
+@njit(cache=True, inline="always")
+def valve_slot(p, pressure_pa, rate_pa_s, static_pa):
+    """The valve's generic slot [Pa] at its state, ``static_pa`` the (delayed) static-map
+    pressure it is driven by (0 on the reference rig)."""
+    error = p[_ACT_GAIN] * static_pa - pressure_pa
+    return basis.slot_value(p, _VALVE_SLOT, (0.0, 0.0, pressure_pa, 0.0, 0.0, 0.0, 0.0, 0.0,
+                                             0.0, 0.0, rate_pa_s, error))
 
 
 @njit(cache=True)
 def settled_response(p, matrices, current):
     """Pressure [Pa] for a held current sequence, starting in steady state at the first
     current (A(s) is stable: the state settles on that level first)."""
+    return settled_states(p, matrices, current)[:, 0]
+
+
+@njit(cache=True)
+def settled_states(p, matrices, current):
+    """A(s)'s state for a held current sequence as :func:`settled_response` steps it, (n, 3):
+    pressure [Pa], its rate [Pa/s], and the delayed static-map pressure [Pa] driving the
+    step from each sample to the next (the valve's slot's signals)."""
     xa = actuator_state(matrices)
     xa[0] = actuator_step(p, matrices, xa, current[0])
     for _ in range(100000):
@@ -149,11 +186,15 @@ def settled_response(p, matrices, current):
         actuator_step(p, matrices, xa, current[0])
         if abs(xa[0] - before) < 1e-9 and abs(xa[1]) < 1e-6:
             break
-    out = np.empty(current.size)
-    out[0] = xa[0]
-    for k in range(current.size - 1):
-        out[k + 1] = actuator_step(p, matrices, xa, current[k])
+    out = np.empty((current.size, 3))
+    newest = PLAY + 1 + int(matrices[ACT_DELAY_STEPS])
+    for k in range(current.size):
+        out[k, 0], out[k, 1] = xa[0], xa[1]
+        if k + 1 < current.size:
+            actuator_step(p, matrices, xa, current[k])
+        out[k, 2] = xa[newest]
     return out
+
 
 
 def actuator_pressure(params: RigParameters, current_a: np.ndarray, rate_hz: float

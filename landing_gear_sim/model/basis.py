@@ -25,16 +25,18 @@ from numba import njit
 # what it does not see). Each has a floor: below it, a step counts the signal as absent and
 # a dead zone passes nothing (a noisy zero is not a signal).
 (OMEGA, SPEED, PRESSURE, LOAD, SLIP, BRAKE_ENERGY, WHEEL_ANGLE, CONTACT_TIME, CURVE,
- RUN_TIME) = range(10)
-N_SIGNALS = 10
+ RUN_TIME, PRESSURE_RATE, VALVE_ERROR) = range(12)
+N_SIGNALS = 12
 SIGNALS: tuple[tuple[str, str], ...] = (
     ("ω", "rad/s"), ("v", "m/s"), ("P", "Pa"), ("F_z", "N"), ("λ", "-"), ("E_b", "J"),
-    ("θ", "rad"), ("t_c", "s"), ("μ_B", "-"), ("t", "s"))
+    ("θ", "rad"), ("t_c", "s"), ("μ_B", "-"), ("t", "s"), ("Ṗ", "Pa/s"), ("ΔP", "Pa"))
 """Each signal's symbol and SI unit, by index (μ_B: the tyre's calibrated curve at the
 slip, so a term may scale it: a friction that falls with speed is μ_B·v; t: the time since
-the run's first sample, as a channel that drifts counts it)."""
-FLOORS = np.array([1.0, 0.5, 0.5e5, 1000.0, 0.005, 1e4, 0.0, 0.0, 0.01, 0.0])
-"""Each signal's floor [its SI unit]: 1 rad/s, 0.5 m/s, 0.5 bar, 1 kN, 0.5 % slip, 10 kJ."""
+the run's first sample, as a channel that drifts counts it; Ṗ and ΔP: the valve's pressure
+rate and what its static map asks beyond the pressure, μ·P_static − P, the states of A(s))."""
+FLOORS = np.array([1.0, 0.5, 0.5e5, 1000.0, 0.005, 1e4, 0.0, 0.0, 0.01, 0.0, 1e5, 0.5e5])
+"""Each signal's floor [its SI unit]: 1 rad/s, 0.5 m/s, 0.5 bar, 1 kN, 0.5 % slip, 10 kJ,
+1 bar/s, 0.5 bar."""
 
 # The shapes a signal goes through; parameter-free, or scaled by the signal's floor.
 (IDENTITY, SIGN, SIGNED_SQUARE, SQUARE, CUBE, STEP, DEAD_ZONE, SIGNED_ROOT, COS1, SIN1,
@@ -86,7 +88,7 @@ def factor_value(factor, signals):
 
 @njit(cache=True)
 def term_value(code, signals):
-    """The basis function ``code`` at ``signals`` (a tuple of N_SIGNALS floats)."""
+    """The basis function ``code`` at ``signals`` (N_SIGNALS floats: a tuple, or a row)."""
     whole = int(code)
     value = factor_value(whole % SECOND, signals)
     if whole >= SECOND:
@@ -111,9 +113,7 @@ def term_values(code, signals):
     """:func:`term_value` of each row of ``signals`` (n, N_SIGNALS)."""
     out = np.empty(signals.shape[0])
     for i in range(out.shape[0]):
-        s = signals[i]
-        out[i] = term_value(code, (s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7], s[8],
-                                    s[9]))
+        out[i] = term_value(code, signals[i])
     return out
 
 
@@ -122,9 +122,7 @@ def slot_values(p, first, signals):
     """:func:`slot_value` of each row of ``signals`` (n, N_SIGNALS)."""
     out = np.empty(signals.shape[0])
     for i in range(out.shape[0]):
-        s = signals[i]
-        out[i] = slot_value(p, first, (s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7],
-                                        s[8], s[9]))
+        out[i] = slot_value(p, first, signals[i])
     return out
 
 

@@ -208,6 +208,8 @@ SPECS: tuple[ParamSpec, ...] = (
                  "sum c_k phi_k"),
     *_slot_terms(K.FX_TERMS, "N", "the load cell's F_x channel: F_x,read = F_x + c F_z + "
                  "sum c_k phi_k"),
+    *_slot_terms(K.VALVE_TERMS, "Pa", "the valve's dynamics A(s): P'' = w_n^2 (mu P_static "
+                 "+ sum c_k phi_k - P) - 2 zeta w_n P'"),
 )
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}

@@ -70,7 +70,7 @@ def tyre_state(p, x, vertical_load_n):
 def wheel_extra(p, x, pressure_pa, vertical_load_n, slip):
     """The torque of the wheel equation's slots at state ``x`` [N m]."""
     signals = (x[OMEGA], x[SPEED], pressure_pa, vertical_load_n, abs(slip), x[E_BRAKE],
-               x[WHEEL_ANGLE], 0.0, 0.0, 0.0)
+               x[WHEEL_ANGLE], 0.0, 0.0, 0.0, 0.0, 0.0)
     return el.wheel_extra_torque(p, x[OMEGA]) + el.wheel_slot_torque(p, signals)
 
 

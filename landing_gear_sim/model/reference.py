@@ -19,7 +19,7 @@ from scipy.integrate import solve_ivp
 from landing_gear_sim.errors import ParameterError
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
-from landing_gear_sim.model.actuator import actuator_system
+from landing_gear_sim.model.actuator import actuator_system, valve_slot
 from landing_gear_sim.model.parameters import INDEX, RigParameters
 from landing_gear_sim.model.plant import (
     ANGLE,
@@ -48,6 +48,7 @@ def reference_solution(params: RigParameters, scenario: Scenario, end_s: float |
     p = params.vector()
     act_a, act_b = actuator_system(params)
     wn = 2 * np.pi * params.number(K.ACTUATOR_NATURAL_FREQUENCY_HZ)
+    slot_b = np.array([0.0, wn * wn])  # the valve's slot's input: A(s) at unit gain
     tau = p[INDEX[K.LOADING_SERVO_TIME_CONSTANT_S]]
     x, dx = np.zeros(N_STATES), np.zeros(N_STATES)
     p_max = p[INDEX[K.ACTUATOR_MAX_PRESSURE_PA]]
@@ -71,7 +72,9 @@ def reference_solution(params: RigParameters, scenario: Scenario, end_s: float |
         derivatives(p, x, y[pressure_i], vertical, dx)
         out = np.empty_like(y)
         out[:pressure_i] = dx[dynamic]
-        out[pressure_i:load_i] = act_a @ y[pressure_i:load_i] + act_b * static
+        pressure, rate = y[pressure_i], y[pressure_i + 1]
+        out[pressure_i:load_i] = (act_a @ y[pressure_i:load_i] + act_b * static
+                                  + slot_b * valve_slot(p, pressure, rate, static))
         reference = el.vertical_load_reference(p, t, y[0]) if scenario.contact else 0.0
         out[load_i] = (reference - y[load_i]) / tau
         return out

@@ -24,6 +24,7 @@ from landing_gear_sim.diagnosis.families import (
     load,
     pressure_skew,
     run_drift,
+    valve_dynamics,
     wheel_skew,
 )
 from landing_gear_sim.diagnosis.families.base import (
@@ -45,6 +46,7 @@ REGISTRY: tuple[Family, ...] = tuple(sorted((
     run_drift.FAMILY,
     load.FAMILY,
     equation_terms.VALVE_FAMILY,
+    valve_dynamics.FAMILY,
     equation_terms.WHEEL_FAMILY,
     equation_terms.TYRE_FAMILY,
     equation_terms.FX_CHANNEL_FAMILY,

@@ -1,0 +1,122 @@
+"""An equation's library of terms, the base every equation's is written on (issues 29, 41).
+
+A :class:`Library` is one equation of the rig: the runs that carry its error
+(:meth:`Library.sources`), its error there beside its terms and the terms the calibration owns
+(:meth:`Library.rows`, regression :class:`~.selection.Rows`), its law with terms written in,
+and its relation, checked by selecting the terms the error needs (:mod:`~.selection`). The
+equations themselves are in :mod:`~.equation_library` and :mod:`~.valve_library`.
+"""
+
+from __future__ import annotations
+
+import abc
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Generic, TypeVar
+
+import numpy as np
+
+from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.calibration.slots import Slot
+from landing_gear_sim.diagnosis.equations import Equation
+from landing_gear_sim.diagnosis.relations import Check, Relation
+from landing_gear_sim.diagnosis.selection import (
+    Rows,
+    Selected,
+    Term,
+    fit_terms,
+    floor_of,
+    significant,
+)
+from landing_gear_sim.model.parameters import RigParameters
+
+EDGE_S = 0.5  # the zero-phase filter's ends are left out
+
+S = TypeVar("S")  # what a library reads one run's rows from: a braking run's signals, ...
+
+
+@dataclass(frozen=True)
+class Campaign:
+    """What the libraries read: a campaign's runs, and its braking runs' filtered signals
+    under the model (prepared once)."""
+
+    runs: Sequence[ClassifiedRun]
+    braking: Sequence[br.Braking]
+
+
+class Library(abc.ABC, Generic[S]):
+    """One equation's generic slot (see the module docstring): its ``terms``, the relation
+    that says whether its error needs them, the unit of its error, the runs it reads
+    (``phase``, in words), and the sign its terms are written with in its law (−1: they
+    oppose, as a bearing's friction)."""
+
+    equation: Equation
+    relation: Relation
+    terms: tuple[Term[S], ...]
+    unit: str
+    phase: str
+    sign: float = -1.0
+    slot: Slot | None = None  # the generic slot its basis terms take places in
+
+    @abc.abstractmethod
+    def sources(self, campaign: Campaign, params: RigParameters) -> list[S]:
+        """What each run that carries the equation's error gives to read it from."""
+
+    @abc.abstractmethod
+    def rows(self, source: S, params: RigParameters,
+             terms: Sequence[Term[S]] | None = None) -> Rows | None:
+        """The regression rows of one run on ``terms`` (default: the library's; None: the
+        run has no samples to give)."""
+
+    @abc.abstractmethod
+    def law(self, written: str, params: RigParameters) -> str:
+        """The equation with its slot's terms ``written`` out in it."""
+
+    def select(self, campaign: Campaign, params: RigParameters) -> list[Selected]:
+        """The library's terms the equation's error needs under ``params``."""
+        rows = self._rows(campaign, params)
+        fitted = fit_terms(self.terms, rows) if rows else None
+        return fitted.selected if fitted and significant(fitted, rows) else []
+
+    def check(self, campaign: Campaign, params: RigParameters) -> Check | None:
+        """The equation's relation over the campaign: what its terms explain jointly (None:
+        no run to tell)."""
+        rows = self._rows(campaign, params)
+        fitted = fit_terms(self.terms, rows) if rows else None
+        if fitted is None or not fitted.selected:
+            return None
+        named = ", ".join(s.term.name for s in fitted.selected)
+        return Check(self.relation, "campaign", f"{self.phase}, {named}", fitted.effect,
+                     fitted.effect / max(fitted.z, 1e-12), floor_of(rows),
+                     self.unit)
+
+    def _rows(self, campaign: Campaign, params: RigParameters) -> list[Rows]:
+        return [r for s in self.sources(campaign, params)
+                if (r := self.rows(s, params)) is not None]
+
+
+class BrakingLibrary(Library[br.Braking]):
+    """A library read from the braking runs."""
+
+    phase = "braking runs"
+
+    def sources(self, campaign: Campaign, params: RigParameters) -> list[br.Braking]:
+        return list(campaign.braking)
+
+
+def thinned(mask: np.ndarray, rate_hz: float) -> np.ndarray:
+    """The indices of ``mask`` away from the filter's ends, one per half period of its
+    cut-off (the signals are low-passed there: closer samples carry no news)."""
+    index = np.flatnonzero(mask)
+    edge = round(EDGE_S * rate_hz)
+    index = index[(index > edge) & (index < mask.size - edge)]
+    return index[::max(1, round(rate_hz / (2 * br.FILTER_HZ)))]
+
+
+def about_run_mean(error: np.ndarray, terms: np.ndarray, owned: np.ndarray, scale: float
+                    ) -> Rows:
+    """Rows about their run's mean (each run's own constant: a static load, a speed's
+    start)."""
+    return Rows(error - error.mean(), terms - terms.mean(axis=0), owned - owned.mean(axis=0),
+                scale)

@@ -1,0 +1,301 @@
+"""The valve's two equations with their libraries (issues 29, 41): its static map, read
+where A(s) has settled, and its dynamics A(s), read over the whole of an actuator run.
+
+A(s)'s generic slot (``actuator.term_*``, :mod:`landing_gear_sim.model.actuator`) adds
+Σ c_k φ_k(P, Ṗ, ΔP) to the pressure the valve is driven by, ΔP = μ P_static − P. Its error
+is an output error (the measured pressure less the model's, through the pressure channel);
+a term enters it as the model pressure's change per unit of its coefficient, the run
+simulated with the term tried (the plant's own step), beside the sensitivities to the
+parameters the calibration owns there (ω_n, ζ, the map, the delay), taken alike.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.calibration.slots import Slot, seen
+from landing_gear_sim.diagnosis.catalogue import ACTUATOR, STATIC_MAP
+from landing_gear_sim.diagnosis.equations import Equation
+from landing_gear_sim.diagnosis.library import Campaign, Library
+from landing_gear_sim.diagnosis.relations import Z_VIOLATED, Relation
+from landing_gear_sim.diagnosis.selection import (
+    Rows,
+    Selected,
+    Term,
+    basis_terms,
+    ordinary_fit,
+    variable,
+)
+from landing_gear_sim.diagnosis.settled_valve import Settled, settled_valve
+from landing_gear_sim.diagnosis.terms import Shaped
+from landing_gear_sim.errors import ParameterError
+from landing_gear_sim.model import basis
+from landing_gear_sim.model import elements as el
+from landing_gear_sim.model import keys as K
+from landing_gear_sim.model.actuator import actuator_matrices, settled_states
+from landing_gear_sim.model.parameters import INDEX, RigParameters
+from landing_gear_sim.model.scenario import logged_to_held
+from landing_gear_sim.model.sensors import SensorModel
+from msg_tools.units import display
+
+VALVE_RATE_HZ = 100.0  # a valve's samples are thinned to this: closer ones add little
+START_S = 0.5  # an actuator run's first samples: the model starts settled, the rig may not
+TURNED = 10.0  # a term that moves the pressure this many times its own size turned A(s) over
+REFINE_STEPS = 3  # Gauss-Newton steps on the kept terms' values
+HALVINGS = 8  # a term tried too large for A(s) is tried again at half, at most this often
+STEP_FRACTION = 1e-4  # an owned parameter's finite-difference step, of its value
+
+
+class ValveLibrary(Library[Settled]):
+    """The valve's static map P = k1 e + k2 e² + k3 e³, e = I − I0: a map that bends
+    beyond the quadratic the calibration fits (flow forces, a spring's progression). Its
+    error is the measured pressure's excess over the model's on an actuator run's settled
+    samples (:func:`~.settled_valve.settled_valve`), where A(s) has settled; the terms the
+    calibration owns there are the map's (k1, k2, and the dead-band's shift: a constant)."""
+
+    equation = Equation.VALVE
+    relation = Relation.VALVE_MAP
+    unit = "Pa"
+    phase = "actuator runs, settled"
+    sign = 1.0
+    terms = (Term(K.ACTUATOR_EXTRA_MAP_PA_PER_A3, "·e³", "Pa/A^3", 2e7,
+                  lambda v, params: _excess(v, params) ** 3),)
+
+    def sources(self, campaign: Campaign, params: RigParameters) -> list[Settled]:
+        return [v for r in campaign.runs if not r.braking
+                and (v := settled_valve(r, params)) is not None]
+
+    def rows(self, source: Settled, params: RigParameters,
+             terms: Sequence[Term[Settled]] | None = None) -> Rows | None:
+        index = np.flatnonzero(source.settled)[::max(1, round(source.rate_hz / VALVE_RATE_HZ))]
+        if index.size < 20:
+            return None
+        gain = params.number(K.ACTUATOR_GAIN)
+        excess = _excess(source, params)[index]
+        owned = gain * np.column_stack([np.ones_like(excess), excess, excess * excess])
+        return Rows(source.residual_pa[index],
+                    gain * np.column_stack([variable(t, source, params)[index]
+                                            for t in terms or self.terms]),
+                    owned, float(np.mean(source.model_pa[index])))
+
+    def law(self, written: str, params: RigParameters) -> str:
+        k1, k2 = (display(params.number(k), unit, ".3g") for k, unit in (
+            (K.ACTUATOR_MAP_K1_PA_PER_A, "Pa/A"), (K.ACTUATOR_MAP_K2_PA_PER_A2, "Pa/A^2")))
+        return f"P_static = {k1}·e + {k2}·e² {written}"
+
+
+def _excess(valve: Settled, params: RigParameters) -> np.ndarray:
+    """The map's variable e = I − I0 ≥ 0 [A] of the current the valve was fed."""
+    return el.valve_excess(valve.current_a, params.number(K.ACTUATOR_MAX_CURRENT_A),
+                           params.number(K.ACTUATOR_DEADBAND_CURRENT_A))
+
+VALVE_TERMS = (
+    Shaped((basis.VALVE_ERROR,), (basis.SIGN, basis.SIGNED_SQUARE, basis.CUBE,
+                                  basis.SIGNED_ROOT))
+    + Shaped((basis.PRESSURE_RATE,), (basis.SIGN, basis.SIGNED_SQUARE, basis.CUBE))
+    + Shaped((basis.PRESSURE,), (basis.IDENTITY,))
+    * Shaped((basis.VALVE_ERROR, basis.PRESSURE_RATE), (basis.IDENTITY,))
+    + Shaped((basis.PRESSURE_RATE,), (basis.SIGN,)) * Shaped((basis.VALVE_ERROR,),
+                                                               (basis.IDENTITY,)))
+"""A(s)'s library: what the valve asks and how fast it moves, in the shapes a spool's
+friction (sgn Ṗ: the pressure held a band off the map, the side it came from), a flow that
+goes as the root of the drop or a damping that goes as the square take (not √Ṗ: its
+infinite slope at rest makes the plant's step ring); the pressure's products with them (a
+valve stiffer or more damped at pressure); a stiffness that differs rising and falling
+(sgn Ṗ·ΔP: a release unlike the apply). ΔP and Ṗ alone are ω_n's and ζ's, the
+calibration's own."""
+
+
+@dataclass(frozen=True)
+class ValveRun:
+    """An actuator run under a model: the current the valve was fed [A], A(s)'s states as
+    the model steps them ((n, 3): P [Pa], Ṗ [Pa/s], the delayed static pressure [Pa]), the
+    measured pressure less the model's through its channel [Pa], the model's sensitivity to
+    each parameter the calibration owns in A(s) ((n, j) [Pa per unit]), its rate [Hz]."""
+
+    current_a: np.ndarray
+    states: np.ndarray
+    residual_pa: np.ndarray
+    owned: np.ndarray
+    matrices: np.ndarray
+    rate_hz: float
+
+
+OWNED = (*ACTUATOR, K.ACTUATOR_GAIN, *STATIC_MAP[:3], K.ACTUATOR_DELAY_S)
+
+
+def valve_run(run: ClassifiedRun, params: RigParameters) -> ValveRun:
+    """``run`` under ``params`` (see :class:`ValveRun`)."""
+    current = logged_to_held(run.command_a)
+    vector = params.vector()
+    matrices = actuator_matrices(vector, 1.0 / run.rate_hz)
+    states = settled_states(vector, matrices, current)
+    channel = SensorModel.of(params).pressure_channel
+    residual = run.pressure_pa - channel(run.time_s, states[:, 0])
+    return ValveRun(current, states, residual,
+                    _sensitivities(params, current, run.rate_hz, states[:, 0]),
+                    matrices, run.rate_hz)
+
+
+def _owned(params: RigParameters) -> tuple[str, ...]:
+    """The owned parameters of A(s) under ``params``: the delay only where it has one."""
+    return tuple(k for k in OWNED if k != K.ACTUATOR_DELAY_S or params.has("actuator_delay"))
+
+
+def _moved(params: RigParameters, codes: list[int], values: np.ndarray, owned: np.ndarray
+           ) -> RigParameters | None:
+    """``params`` with the terms ``codes`` at ``values`` in A(s)'s slot and the owned
+    parameters moved by ``owned`` (None: a step out of their bounds)."""
+    changes = {key: params.number(key) + shift for key, shift in zip(_owned(params), owned,
+                                                                      strict=True)}
+    for (code_key, coeff_key), code, value in zip(Slot.VALVE.keys, codes, values,
+                                                  strict=False):
+        changes[code_key], changes[coeff_key] = float(code), float(value)
+    try:
+        return params.replace(changes, "refined")
+    except ParameterError:
+        return None
+
+
+def _sensitivities(params: RigParameters, current_a: np.ndarray, rate_hz: float,
+                   model_pa: np.ndarray) -> np.ndarray:
+    """The model pressure's change per unit of each owned parameter, (n, j)."""
+    columns = []
+    for key in _owned(params):
+        value = params.number(key)
+        step = STEP_FRACTION * max(abs(value), 1e-3 if key == K.ACTUATOR_DELAY_S else 1e-6)
+        moved = params.replace({key: value + step}, "sensitivity").vector()
+        pressure = settled_states(moved, actuator_matrices(moved, 1.0 / rate_hz),
+                                  current_a)[:, 0]
+        columns.append((pressure - model_pa) / step)
+    return np.column_stack(columns)
+
+
+def valve_signals(states: np.ndarray, gain: float) -> np.ndarray:
+    """``model.basis``'s signals A(s)'s slot sees at ``states`` (:class:`ValveRun`'s),
+    (n, N_SIGNALS)."""
+    out = np.zeros((states.shape[0], basis.N_SIGNALS))
+    out[:, basis.PRESSURE] = states[:, 0]
+    out[:, basis.PRESSURE_RATE] = states[:, 1]
+    out[:, basis.VALVE_ERROR] = gain * states[:, 2] - states[:, 0]
+    return seen(Slot.VALVE, out)
+
+
+def _free_place(params: RigParameters) -> int | None:
+    """The first free place of A(s)'s slot (its code's index in the vector; None: full)."""
+    free = [code for code, coeff in Slot.VALVE.keys if params.number(coeff) == 0.0]
+    return INDEX[free[0]] if free else None
+
+
+def _secant(v: ValveRun, params: RigParameters, code: int, place: int) -> np.ndarray:
+    """The model pressure's change per unit of the term ``code``'s coefficient [Pa per unit],
+    (n,): the run simulated with the term tried at a coefficient that takes at most the
+    error's rms off A(s)'s input along the model's states (a secant over the size of what
+    is to be explained: a spool's friction is no linear law), halved while that turns A(s)
+    over (moves the pressure TURNED times the size). The plant's own step, so a friction
+    holds the model a band off where it settles (a derivative at 0 sees nothing there);
+    taken off, as a friction's is (a sign term pushing the spool on is another law, a relay
+    that chatters about the map)."""
+    signals = valve_signals(v.states, params.number(K.ACTUATOR_GAIN))
+    largest = float(np.max(np.abs(basis.term_values(code, signals))))
+    size = float(np.sqrt(np.mean(v.residual_pa ** 2)))
+    vector = params.vector().copy()
+    vector[place] = float(code)
+    for _ in range(HALVINGS if largest > 0.0 else 0):
+        vector[place + 1] = coeff = -size / largest
+        change = settled_states(vector, v.matrices, v.current_a)[:, 0] - v.states[:, 0]
+        if np.all(np.abs(change) < TURNED * size):
+            return change / coeff
+        size /= 2.0
+    return np.zeros(v.states.shape[0])
+
+
+class ValveDynamicsLibrary(Library[ValveRun]):
+    """A(s): P̈ = ω_n² (μ P_static + Σ c_k φ_k − P) − 2 ζ ω_n Ṗ: a spool that sticks, a
+    valve that stiffens with pressure, a release unlike the apply. Its error is the
+    measured pressure less the model's over an actuator run (after its first
+    :data:`START_S`), thinned to :data:`VALVE_RATE_HZ`; owned: ω_n, ζ, μ, the map, the
+    delay."""
+
+    equation = Equation.VALVE
+    relation = Relation.VALVE_DYNAMICS
+    unit = "Pa"
+    phase = "actuator runs"
+    sign = 1.0
+    slot = Slot.VALVE
+    terms = basis_terms(VALVE_TERMS, "Pa")
+
+    def select(self, campaign: Campaign, params: RigParameters) -> list[Selected]:
+        """The kept terms, their values refined by Gauss-Newton steps with the owned
+        parameters (a stiffening the calibration took into ω_n is half a term's first
+        fit: the error is linearised about a model that is not the rig's); a term the
+        refined fit does not find is dropped, the weakest first."""
+        chosen = super().select(campaign, params)
+        if any(s.term.code is None for s in chosen):
+            return chosen
+        runs = [r for r in campaign.runs if not r.braking]
+        while chosen:
+            refined = self._refined(runs, params, chosen)
+            if refined is None:
+                return chosen
+            values, t = refined
+            if len(chosen) == 1 or t.min() >= Z_VIOLATED:
+                return [replace(s, value=float(v), t=float(z))
+                        for s, v, z in zip(chosen, values, t, strict=True)]
+            chosen = [s for i, s in enumerate(chosen) if i != int(np.argmin(t))]
+        return chosen
+
+    def _refined(self, runs: Sequence[ClassifiedRun], params: RigParameters,
+                 chosen: list[Selected]) -> tuple[np.ndarray, np.ndarray] | None:
+        """The ``chosen`` terms' values after REFINE_STEPS Gauss-Newton steps, and each
+        value over its σ there (None: a step left the owned parameters' bounds)."""
+        terms = [s.term for s in chosen]
+        values, owned = np.array([s.value for s in chosen]), np.zeros(len(_owned(params)))
+        t = np.full(values.size, np.inf)
+        for _ in range(REFINE_STEPS):
+            trial = _moved(params, [int(s.term.code or 0) for s in chosen], values, owned)
+            rows = [r for run in runs if trial is not None
+                    and (r := self.rows(valve_run(run, trial), trial, terms)) is not None]
+            if trial is None or not rows:
+                return None
+            design = np.vstack([np.hstack([r.terms, r.owned]) for r in rows])
+            step, z = ordinary_fit(design, np.concatenate([r.error for r in rows]))
+            values, owned = values + step[:values.size], owned + step[values.size:]
+            sigma = np.abs(step[:values.size]) / np.maximum(z[:values.size], 1e-300)
+            t = np.abs(values) / np.maximum(sigma, 1e-300)
+        return values, t
+
+    def sources(self, campaign: Campaign, params: RigParameters) -> list[ValveRun]:
+        if not params.has("actuator_dynamics"):
+            return []
+        return [valve_run(r, params) for r in campaign.runs if not r.braking]
+
+    def rows(self, source: ValveRun, params: RigParameters,
+             terms: Sequence[Term[ValveRun]] | None = None) -> Rows | None:
+        n = source.residual_pa.size
+        index = np.arange(round(START_S * source.rate_hz), n,
+                          max(1, round(source.rate_hz / VALVE_RATE_HZ)))
+        if index.size < 20:
+            return None
+        scale = float(np.mean(np.abs(source.states[index, 0])))
+        place = _free_place(params)
+        if place is None:
+            return None
+        columns = [_secant(source, params, t.code, place)
+                   if t.code is not None else variable(t, source, params)
+                   for t in terms or self.terms]
+        return Rows(source.residual_pa[index], np.column_stack(columns)[index],
+                    source.owned[index], scale)
+
+    def law(self, written: str, params: RigParameters) -> str:
+        wn = display(params.number(K.ACTUATOR_NATURAL_FREQUENCY_HZ), "Hz", ".3g")
+        zeta = params.number(K.ACTUATOR_DAMPING_RATIO)
+        return f"P̈ = ω_n²·(μ·P_static − P {written}) − 2·{zeta:.3g}·ω_n·Ṗ, ω_n = 2π·{wn}"
+
+
+VALVE = ValveLibrary()
+VALVE_DYNAMICS = ValveDynamicsLibrary()

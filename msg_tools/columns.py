@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 
 from .checks import check_plausible
-from .contract import CSV_COLUMNS, CSV_TO_FIELD
+from .contract import CSV_COLUMNS, CSV_TO_FIELD, RIG_COLUMNS
 from .errors import RunFormatError
 from .mapping import DATETIME, DEFAULT_MAPPING, Channel, Mapping
 from .run import Run
@@ -19,6 +19,11 @@ from .units import QUANTITY, UNITS, parse_unit
 
 def wanted_columns(mapping: Mapping) -> list[str]:
     return [mapping[c].column for c in CSV_COLUMNS]
+
+
+def rig_columns(mapping: Mapping) -> list[str]:
+    """The columns an actuator-only log may lack as a group (:data:`RIG_COLUMNS`)."""
+    return [mapping[c].column for c in RIG_COLUMNS]
 
 
 def text_columns(mapping: Mapping) -> list[str]:
@@ -33,6 +38,11 @@ def run_from_table(table: Table, where: str, name: str, mapping: Mapping | None 
     fields: dict[str, np.ndarray] = {}
     notes = table.notes
     channels = _channels(table, where, mapping)
+    if not set(RIG_COLUMNS) & set(channels):  # an actuator-only log: the wheel off
+        zeros = np.zeros(np.shape(table.columns[channels["time_s"].column]))
+        fields.update({CSV_TO_FIELD[c]: zeros for c in RIG_COLUMNS})
+        notes += (f"{where}: no wheel, flywheel or load channels: an actuator-only log, "
+                  "read with the wheel off the flywheel (they are 0)",)
     uses = Counter(channel.column for channel in channels.values())
     for contract, channel in channels.items():
         raw = table.columns[channel.column]
@@ -48,15 +58,20 @@ def run_from_table(table: Table, where: str, name: str, mapping: Mapping | None 
 
 def _channels(table: Table, where: str, mapping: Mapping) -> dict[str, Channel]:
     """Each contract column's channel in ``table``, in the unit the file states."""
-    channels = {}
+    channels, missing = {}, []
     for contract in CSV_COLUMNS:
         channel = _with_written_unit(_master_time(mapping[contract], contract, table),
                                      contract, table, where)
-        if channel.column not in table.columns:
-            found = ", ".join(table.columns) or "none"
-            raise RunFormatError(f"{where}: missing column {channel.column} for {contract} "
-                                 f"(found {found}); name it in a column-mapping file")
-        channels[contract] = channel
+        if channel.column in table.columns:
+            channels[contract] = channel
+        else:
+            missing.append((contract, channel.column))
+    if missing and [c for c, _ in missing] != list(RIG_COLUMNS):  # all of them: actuator-only
+        found = ", ".join(table.columns) or "none"
+        named = ", ".join(f"{column} for {contract}" for contract, column in missing)
+        raise RunFormatError(f"{where}: missing column(s) {named} (found {found}); name "
+                             "them in a column-mapping file (an actuator-only log may leave "
+                             "out all four wheel, flywheel and load channels, not some)")
     return channels
 
 

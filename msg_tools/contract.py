@@ -19,6 +19,10 @@ The current of a row is the command in force over the sample interval that ends 
 row's time (the row's pressure already reflects it); the same holds for a bag's
 current_ref at its log time."""
 
+RIG_COLUMNS: tuple[str, ...] = CSV_COLUMNS[3:]
+"""The columns an actuator-only logger may leave out as a group (wheel off the flywheel:
+they read 0); time, current and pressure every run has."""
+
 CSV_SCALE_TO_SI: dict[str, float] = {
     "time_s": 1.0, "current_ref_A": 1.0, "brake_pressure_bar": PA_PER_BAR,
     "wheel_speed_rad_s": 1.0, "flywheel_speed_rad_s": 1.0, "vertical_load_N": 1.0,

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .columns import run_from_table, text_columns, wanted_columns
+from .columns import rig_columns, run_from_table, text_columns, wanted_columns
 from .contract import CSV_COLUMNS, CSV_SCALE_TO_SI, CSV_TO_FIELD
 from .mapping import DEFAULT_MAPPING, Mapping
 from .mapping import read_mapping as read_mapping
@@ -37,16 +37,17 @@ def read_csv(path: Path, name: str | None = None, mapping: Mapping | None = None
             values, time not strictly increasing; the message names the file.
     """
     path = Path(path)
-    return read_named(path, lambda wanted, text: read_table_file(path, wanted, str(path), text),
-                      name, mapping)
+    return read_named(path, lambda wanted, text, optional: read_table_file(
+        path, wanted, str(path), text, optional), name, mapping)
 
 
-def read_named(path: Path, table_of: Callable[[list[str], list[str]], Table],
+def read_named(path: Path, table_of: Callable[[list[str], list[str], list[str]], Table],
                name: str | None = None, mapping: Mapping | None = None) -> Run:
-    """The run of ``path`` whose table ``table_of`` reads, given the columns it must find
-    and those read as text (a delimited text file, a workbook's sheet)."""
+    """The run of ``path`` whose table ``table_of`` reads, given the columns it must find,
+    those read as text and those an actuator-only log may lack (a delimited text file, a
+    workbook's sheet)."""
     mapping = mapping or DEFAULT_MAPPING
-    table = table_of(wanted_columns(mapping), text_columns(mapping))
+    table = table_of(wanted_columns(mapping), text_columns(mapping), rig_columns(mapping))
     return run_from_table(table, str(path), name or run_name(path), mapping)
 
 

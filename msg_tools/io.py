@@ -70,8 +70,8 @@ def read_run(path: Path, mapping: Mapping | None = None, name: str | None = None
     if kind == "text":
         return read_csv(path, name, mapping)
     if kind == "workbook":
-        return read_named(path, lambda wanted, text: read_workbook(path, wanted, text), name,
-                          mapping)
+        return read_named(path, lambda wanted, text, optional: read_workbook(
+            path, wanted, text, optional), name, mapping)
     if kind == "binary":
         table = READERS[path.suffix.lower()](path)
         return run_from_table(table, str(path), name or run_name(path), mapping)

@@ -40,7 +40,7 @@ CHUNK_ROWS = 5_000  # rows parsed at a time: ~0.5 MB of text
 
 
 def read_table_file(path: Path, wanted: Sequence[str], where: str,
-                    text_columns: Sequence[str] = ()) -> Table:
+                    text_columns: Sequence[str] = (), optional: Sequence[str] = ()) -> Table:
     """:func:`~msg_tools.text_table.read_table` of the file at ``path``. A text column
     (time, which may be a clock time) read by the shortcut holds numbers: a column that
     is no numbers goes the whole-text way."""
@@ -50,13 +50,14 @@ def read_table_file(path: Path, wanted: Sequence[str], where: str,
             large = path.stat().st_size >= LARGE_BYTES
         except OSError:
             large = False
-        table = _streamed(path, wanted, where) if large else None
+        table = _streamed(path, wanted, where, optional) if large else None
         if table is not None:
             return table
-    return read_table(read_text(path), wanted, where, text_columns)
+    return read_table(read_text(path), wanted, where, text_columns, optional)
 
 
-def _streamed(path: Path, wanted: Sequence[str], where: str) -> Table | None:
+def _streamed(path: Path, wanted: Sequence[str], where: str, optional: Sequence[str] = ()
+              ) -> Table | None:
     """The table read from the open file, or None where the layout needs the whole text."""
     ends = _ends(path)
     if ends is None:
@@ -72,9 +73,10 @@ def _streamed(path: Path, wanted: Sequence[str], where: str) -> Table | None:
     if not 0 < first < last:
         return None
     try:
-        header = read_header(head[:first], dialect, wanted, where)
+        header = read_header(head[:first], dialect, wanted, where, optional)
     except RunFormatError:
         return None
+    wanted = header.present
     values = _load(path, encoding, dialect, [header.column(w) for w in wanted], first)
     if values is None:
         return None

@@ -84,13 +84,15 @@ class Dialect:
 
 
 def read_table(text: str, wanted: Sequence[str], where: str,
-               text_columns: Sequence[str] = ()) -> Table:
-    """The ``wanted`` columns of ``text`` (numbers; ``text_columns`` as text). A wanted
-    name may be the whole header cell, unit included (``t [s]``, copied from the file)."""
+               text_columns: Sequence[str] = (), optional: Sequence[str] = ()) -> Table:
+    """The ``wanted`` columns of ``text`` (numbers; ``text_columns`` as text), those of them
+    ``optional`` where the header has them. A wanted name may be the whole header cell,
+    unit included (``t [s]``, copied from the file)."""
     lines, notes = _complete_lines(text, where)
     dialect = sniff(lines, where)
     first, last = data_block(lines, dialect)
-    header = read_header(lines[:first], dialect, wanted, where)
+    header = read_header(lines[:first], dialect, wanted, where, optional)
+    wanted = header.present
     body = lines[first:last]
     numeric = [w for w in wanted if w not in text_columns]
     values, grouped = _numbers(body, dialect, header.names,
@@ -113,27 +115,37 @@ class Header:
     names: list[str]
     units: dict[str, str]
     bare: dict[str, str]
+    present: list[str]  # the wanted names the header has (an optional one may be absent)
 
     def column(self, wanted: str) -> int:
         return self.names.index(self.bare[wanted])
 
 
-def read_header(above: list[str], dialect: Dialect, wanted: Sequence[str], where: str
-                ) -> Header:
-    """The :class:`Header` of the lines ``above`` the data that names ``wanted``.
+def read_header(above: list[str], dialect: Dialect, wanted: Sequence[str], where: str,
+                optional: Sequence[str] = ()) -> Header:
+    """The :class:`Header` of the lines ``above`` the data that names ``wanted`` (those of
+    them ``optional`` where it has them).
 
     Raises:
         RunFormatError: no header row, or a wanted column missing (named).
     """
     bare = {w: _name(w) for w in wanted}
-    header_at, names = find_header(above, dialect, list(dict.fromkeys(bare.values())), where)
+    required = [w for w in wanted if w not in optional]
+    try:
+        header_at, names = find_header(above, dialect, list(dict.fromkeys(
+            bare[w] for w in required)), where)
+    except RunFormatError:
+        find_header(above, dialect, list(dict.fromkeys(bare.values())), where)  # names all
+        raise
     units = _header_units(above[header_at], dialect, names)
     for row in above[header_at + 1:]:  # units rows, down to the data
         cells = split(row, dialect.separator)
         if len(cells) == len(names):
             units.update({n: c.strip() for n, c in zip(names, cells, strict=True) if c.strip()})
     units.update({w: units[b] for w, b in bare.items() if w != b and b in units})
-    return Header(names, units, bare)
+    folded = {n.lower(): n for n in names}
+    bare = {w: b if b in names else folded.get(b.lower(), b) for w, b in bare.items()}
+    return Header(names, units, bare, [w for w in wanted if bare[w] in names])
 
 
 def _complete_lines(text: str, where: str) -> tuple[list[str], tuple[str, ...]]:

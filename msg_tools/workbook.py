@@ -23,8 +23,8 @@ from .text_table import Table, read_table
 SUFFIXES = (".xlsx", ".xlsm")
 
 
-def read_workbook(path: Path, wanted: Sequence[str], text_columns: Sequence[str] = ()
-                  ) -> Table:
+def read_workbook(path: Path, wanted: Sequence[str], text_columns: Sequence[str] = (),
+                  optional: Sequence[str] = ()) -> Table:
     """The ``wanted`` columns of the first sheet of ``path`` that holds them all; when none
     does, an error naming each sheet with what it holds."""
     openpyxl = library("openpyxl", path)
@@ -38,7 +38,8 @@ def read_workbook(path: Path, wanted: Sequence[str], text_columns: Sequence[str]
         for sheet in book.worksheets:
             text = _as_text(sheet.iter_rows(values_only=True))
             try:
-                return read_table(text, wanted, f"{path} sheet {sheet.title}", text_columns)
+                return read_table(text, wanted, f"{path} sheet {sheet.title}", text_columns,
+                                  optional)
             except RunFormatError as exc:
                 errors.append(str(exc).removeprefix(f"{path} "))
     finally:

@@ -8,7 +8,8 @@ tests and benchmarks; identification and diagnosis never read that file.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import functools
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -36,6 +37,10 @@ NOISE = {K.SENSORS_PRESSURE_NOISE_PA: 1.5e4, K.SENSORS_SPEED_NOISE_RAD_S: 0.1,
 GENERATING_FILE = "generating-parameters.yaml"
 LIGHT_LOAD = 0.7
 LIGHT_BAR = (14, 21, 28)
+STANDARD_RUNS = ("actuator_ramp", "actuator_steps_sweep",
+                 *(f"brake_const_{bar}bar" for bar in (10, 20, 30, 40)), "brake_osc_low",
+                 "brake_osc_high", *(f"brake_const_{bar}bar_light" for bar in LIGHT_BAR))
+"""The standard runs' names in the order their noise is drawn."""
 LIGHT_SPEED_M_S = 45.0
 """The light stops (``light=True``): constant-pressure stops at a lighter static load
 (× LIGHT_LOAD). On the rig the load follows the speed (F_z0 − k_L v²), so only runs at
@@ -56,26 +61,31 @@ def rig_like(datasheet: RigParameters, rng: np.random.Generator,
     return datasheet.replace({**changes, **NOISE}, "rig generator")
 
 
-def standard_scenarios(p: RigParameters, light: bool = False) -> dict[str, sc.Scenario]:
+def standard_scenarios(p: RigParameters, light: bool = False,
+                       names: Sequence[str] | None = None) -> dict[str, sc.Scenario]:
     """The runs of a calibration campaign: those of the example campaigns (same names), and
     with ``light`` the constant-pressure stops at a lighter static load (`_light`, see
-    LIGHT_BAR)."""
+    LIGHT_BAR); only ``names`` when given (a slow valve's 12 bar holds no 20 bar stop)."""
     max_current = p.number(K.ACTUATOR_MAX_CURRENT_A)
-    standard = {
-        "actuator_ramp": sc.actuator_test(p, sc.quasi_static_ramp(max_current), 20.0,
-                                          "actuator_ramp"),
-        "actuator_steps_sweep": sc.actuator_test(p, sc.steps_then_sweep(), 28.0,
-                                                 "actuator_steps_sweep"),
-        **{f"brake_const_{bar}bar": sc.constant_pressure_test(p, bar * PA_PER_BAR)
+    made: dict[str, Callable[[], sc.Scenario]] = {
+        "actuator_ramp": lambda: sc.actuator_test(p, sc.quasi_static_ramp(max_current), 20.0,
+                                                  "actuator_ramp"),
+        "actuator_steps_sweep": lambda: sc.actuator_test(p, sc.steps_then_sweep(), 28.0,
+                                                         "actuator_steps_sweep"),
+        **{f"brake_const_{bar}bar": functools.partial(sc.constant_pressure_test, p,
+                                                      bar * PA_PER_BAR)
            for bar in (10, 20, 30, 40)},
-        "brake_osc_low": sc.rig_test(p, sc.oscillating(**sc.OSC_LOW), "brake_osc_low"),
-        "brake_osc_high": sc.rig_test(p, sc.oscillating(**sc.OSC_HIGH), "brake_osc_high"),
+        "brake_osc_low": lambda: sc.rig_test(p, sc.oscillating(**sc.OSC_LOW), "brake_osc_low"),
+        "brake_osc_high": lambda: sc.rig_test(p, sc.oscillating(**sc.OSC_HIGH),
+                                              "brake_osc_high"),
     }
+    standard = {name: make() for name, make in made.items() if names is None or name in names}
     if not light:
         return standard
     return standard | {f"brake_const_{bar}bar_light": sc.rig_test(
         _light(p), sc.constant(sc.current_for_pressure(p, bar * PA_PER_BAR)),
-        f"brake_const_{bar}bar_light") for bar in LIGHT_BAR}
+        f"brake_const_{bar}bar_light") for bar in LIGHT_BAR
+        if names is None or f"brake_const_{bar}bar_light" in names}
 
 
 def _campaign_order(braking: Sequence[str]) -> dict[str, float]:
@@ -120,12 +130,10 @@ def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,
     rig.to_yaml(folder / GENERATING_FILE)
     if logger.rate_hz is not None:
         rig = rig.replace({K.SIMULATION_OUTPUT_RATE_HZ: logger.rate_hz}, "the logger's rate")
-    scenarios = standard_scenarios(rig, light)
-    order = _campaign_order([n for n, s in scenarios.items() if s.contact
-                             and (names is None or n in names)])
-    for i, (name, scenario) in enumerate(scenarios.items()):
-        if names is not None and name not in names:
-            continue
+    scenarios = standard_scenarios(rig, light, names)
+    order = _campaign_order([n for n, s in scenarios.items() if s.contact])
+    for name, scenario in scenarios.items():
+        i = STANDARD_RUNS.index(name)  # a run's noise is its own, whichever others are made
         params = _start_angle(_loaded(run_parameters(rig, order.get(name, 0.0)), name),
                               np.random.default_rng([seed, i]))
         result = simulate(params, scenario)

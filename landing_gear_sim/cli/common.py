@@ -78,7 +78,9 @@ def check_inputs(args: argparse.Namespace) -> None:
 
 def add_params_arguments(parser: argparse.ArgumentParser, without: bool = True) -> None:
     parser.add_argument("--config", action="append", type=InputPath, metavar="FILE",
-                        help="ROS 2 params file; repeat to layer (default: bundled reference rig)")
+                        help="ROS 2 params file naming what differs from the bundled "
+                        "reference rig (a datasheet, or a whole calibrated set); repeat to "
+                        "layer")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                         help="override one parameter, e.g. --set friction.theta1=0.8")
     if without:
@@ -110,7 +112,7 @@ def add_run_arguments(parser: argparse.ArgumentParser) -> None:
 def params_of(args: argparse.Namespace) -> RigParameters:
     """The parameter set of ``--config``, ``--set`` and ``--without``."""
     overrides = dict(parse_assignment(text) for text in args.set)
-    params = load_parameters(args.config, overrides or None)
+    params = load_parameters(args.config, overrides or None, over_reference=True)
     removed = getattr(args, "without", None)
     return params.without(*removed) if removed else params
 

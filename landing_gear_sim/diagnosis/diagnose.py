@@ -42,6 +42,7 @@ from landing_gear_sim.diagnosis.findings import Finding, Signature
 from landing_gear_sim.diagnosis.identifiability import actuator_calibrated, untestable
 from landing_gear_sim.diagnosis.local import LocalGain, local_gains
 from landing_gear_sim.diagnosis.relations import Check, violations
+from landing_gear_sim.diagnosis.rig_bounds import scaled_to_rig
 from landing_gear_sim.diagnosis.scoring import (
     BIC_THRESHOLD,
     Scored,
@@ -58,6 +59,7 @@ from landing_gear_sim.diagnosis.signatures import (
 )
 from landing_gear_sim.diagnosis.start import FRICTION_CURVE, starting_model
 from landing_gear_sim.errors import DiagnosisError, IdentificationError
+from landing_gear_sim.model.datasheet import datasheet_values
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.processes import pool_worker, single_threaded_blas
 from msg_tools.run import Run
@@ -103,7 +105,8 @@ class Diagnosis:
                 "consistency_calibrated": [c.to_json() for c in self.consistency_calibrated],
                 "local_gains": {"calibrated": [g.to_json() for g in self.local_before],
                                 "extended": [g.to_json() for g in self.local_after]},
-                "problems": self.problems}
+                "problems": self.problems,
+                "datasheet": datasheet_values(self.start)}
 
 
 def candidates_for(start: RigParameters, without: Sequence[str]) -> list[Candidate]:
@@ -139,7 +142,8 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
                            runs)
     before = [s for s in tried if not s.tentative]
     scales = noise_scales(runs, tuple(CHANNELS))
-    pending, skipped = _testable(candidates_for(start, without), runs, problems, say)
+    pending, skipped = _testable(scaled_to_rig(candidates_for(start, without), runs, start),
+                                 runs, problems, say)
     model = calibrated
     accepted: list[Scored] = []
     table: list[Finding] = []
@@ -207,7 +211,8 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
 
 def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],
               problems: list[str], say: Progress) -> tuple[list[Candidate], list[str]]:
-    """The candidates the runs can identify; the others noted in ``problems`` (causes)."""
+    """The candidates the runs can identify, and the causes of the others that could hide
+    in what the runs show; every other noted in ``problems``."""
     testable, skipped = [], []
     for candidate in candidates:
         reason = untestable(candidate, runs)
@@ -217,7 +222,14 @@ def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],
             skipped.append(candidate.cause)
         else:
             testable.append(candidate)
-    return testable, skipped
+    return testable, [c for c in skipped if _could_show(CATALOGUE[c], runs)]
+
+
+def _could_show(candidate: Candidate, runs: Sequence[ClassifiedRun]) -> bool:
+    """Whether an untested ``candidate`` could be what the runs show: not one seen only in
+    braking runs' channels when no run brakes (an actuator-only log's verdict is the
+    valve's; a tyre's relaxation cannot hide in it)."""
+    return any(r.braking for r in runs) or "pressure_pa" in candidate.channels
 
 
 def _interpretable(signatures: list[Signature], runs: Sequence[ClassifiedRun]

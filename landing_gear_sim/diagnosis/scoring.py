@@ -86,7 +86,8 @@ def split_runs(candidate: Candidate, runs: Sequence[Run]
 
     Actuator effects are checked on the braking runs' pressure. Otherwise the runs
     of each class are sorted by length and alternate between the two sets (the
-    shorter to fitting), so both see every kind of test.
+    shorter to fitting), so both see every kind of test; with none to spare, an actuator
+    run's later part is held out in time (:func:`_held_out_in_time`).
     """
     classified = classify_all(runs)
     own = select(classified, candidate.runs) or select(
@@ -102,7 +103,35 @@ def split_runs(candidate: Candidate, runs: Sequence[Run]
     for members in by_class.values():
         for i, r in enumerate(sorted(members, key=len)):
             (fit if i % 2 == 0 else held).append(r)
+    if not held:
+        return _held_out_in_time(fit)
     return fit, held
+
+
+SETTLED_SPLIT_S = 0.5  # a run cut in time is cut where the current has held this long
+
+
+def _held_out_in_time(fit: list[ClassifiedRun]
+                      ) -> tuple[list[ClassifiedRun], list[ClassifiedRun]]:
+    """With no run of a kind to spare, the longest actuator run's later part held out in
+    time (fit on its first transitions, check on the rest): cut nearest its middle (within
+    its middle 80 %) where the current has held SETTLED_SPLIT_S, so the held-out part
+    starts settled, as a simulation of a run does. Braking runs are not cut (a stop is one
+    piece)."""
+    cuttable = [r for r in fit if not r.braking]
+    if not cuttable:
+        return fit, []
+    run = max(cuttable, key=len)
+    width = max(1, round(SETTLED_SPLIT_S * run.rate_hz))
+    held_still = np.convolve(np.diff(run.current_a, prepend=run.current_a[0]) != 0.0,
+                             np.ones(width), mode="full")[:len(run)] == 0
+    candidates = np.flatnonzero(held_still[len(run) // 10: 9 * len(run) // 10]) + len(run) // 10
+    if candidates.size == 0:
+        return fit, []
+    cut = int(candidates[np.argmin(np.abs(candidates - len(run) // 2))])
+    first, later = (ClassifiedRun.of(run.part(part, f"{run.name} ({which})"))
+                    for part, which in ((slice(0, cut), "before"), (slice(cut, None), "after")))
+    return [first if r is run else r for r in fit], [later]
 
 
 @dataclass(frozen=True)
@@ -125,6 +154,9 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
     The candidate's fit starts from ``start`` when given (a model calibrated again with
     it), its null's from ``model`` (the best the runs give without it)."""
     fit_runs, held_runs = split_runs(candidate, runs)
+    scales = {**scales, **{(part.name, channel): value for part in (*fit_runs, *held_runs)
+                           for (name, channel), value in scales.items()
+                           if part.name.startswith(f"{name} (")}}  # a run cut in time
     sub = _as_fitting(candidate, fit_runs)
     if candidate.settings:
         model = model.replace(dict(candidate.settings), f"{candidate.family}'s terms")

@@ -128,8 +128,8 @@ def fit_terms(terms: Sequence[Term[Any]], rows: Sequence[Rows]) -> Fitted | None
     term when the lasso keeps none: the relation is checked all the same)."""
     y = np.concatenate([r.error for r in rows])
     x, owned = np.vstack([r.terms for r in rows]), np.vstack([r.owned for r in rows])
-    if y.size < 10 * (x.shape[1] + owned.shape[1]):
-        return None
+    if y.size < 10 * (x.shape[1] + owned.shape[1]) or not np.any(y):
+        return None  # too few samples, or an error exactly 0 (a channel not logged)
     apart = _told_apart(x, owned)
     lasso = np.zeros(x.shape[1])
     lasso[apart] = sparse_coefficients(np.hstack([x[:, apart], owned]), y,

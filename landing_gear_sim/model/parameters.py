@@ -294,6 +294,7 @@ class RigParameters:
 def load_parameters(
     files: Sequence[Path | str] | None = None,
     overrides: Mapping[str, Value] | None = None,
+    over_reference: bool = False,
 ) -> RigParameters:
     """Load and validate a parameter set.
 
@@ -302,13 +303,16 @@ def load_parameters(
             the bundled reference rig. A file may hold only some keys (an overlay),
             but the union must define every key.
         overrides: final ``{key: value}`` changes (e.g. from ``--set``).
+        over_reference: ``files`` layered over the bundled reference rig: a user's
+            datasheet names only what differs (as the graph's nodes read a params file).
 
     Raises:
         ParameterError: a file is unreadable, or a value is missing, unknown,
             negative, non-finite or of the wrong type; the message names the key
             and the file.
     """
-    paths = [Path(f) for f in files] if files else default_config_files()
+    given = [Path(f) for f in files or ()]
+    paths = [*default_config_files(), *given] if over_reference or not given else given
     values: dict[str, Value] = {}
     origin: dict[str, str] = {}
     for path in paths:

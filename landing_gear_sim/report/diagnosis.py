@@ -22,6 +22,8 @@ from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.relations import Z_VIOLATED, Check, Relation
 from landing_gear_sim.diagnosis.residuals import Spectrum
 from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, HELD_OUT_THRESHOLD
+from landing_gear_sim.model.datasheet import UNITS, datasheet_values
+from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.report.figures import DISPLAY_UNITS, save_figure
 from landing_gear_sim.report.local import local_gain_section
 from landing_gear_sim.report.pages import html_image, html_table, text_table, write_html
@@ -184,7 +186,8 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
           _text(_gain(f.held_out)), ", ".join(f.fitted_on), ", ".join(f.checked_on)]
          for f in result.candidates])
     verdict = (f"<p><b>{html.escape(headline(result))}</b></p><p>Starting model: "
-               f"{', '.join(result.start.sources)}. ΔBIC = BIC(with) − BIC(without) on the "
+               f"{', '.join(result.start.sources)}{html.escape(_datasheet(result.start))}. "
+               "ΔBIC = BIC(with) − BIC(without) on the "
                f"fitting runs (accepted below {BIC_THRESHOLD:g}, and only if the held-out "
                f"runs improve by more than {-HELD_OUT_THRESHOLD:g} in the same "
                f"log-likelihood units).</p>")
@@ -301,6 +304,17 @@ def _colour(check: Check | None) -> str:
     if check is None or not check.z > Z_VIOLATED:
         return "tab:grey"
     return "tab:red" if check.violated else "tab:orange"
+
+
+def _datasheet(params: RigParameters) -> str:
+    """The values the user's params files gave beyond the bundled reference rig, in words."""
+    given = datasheet_values(params)
+    if not given:
+        return ""
+    shown = ", ".join(f"{key} = {display(float(value), UNITS[key], '.4g')}"
+                      if isinstance(value, float) else f"{key} = {value}"
+                      for key, value in given.items())
+    return f" (from the datasheet, over the reference rig: {shown})"
 
 
 def _text(value: float | None) -> str:

@@ -305,6 +305,21 @@ def unseen_task(folder: str, equation: str) -> dict:
             "seconds": round(time.perf_counter() - started, 1)}
 
 
+def datasheet_task(folder: str) -> dict:
+    """One campaign of another rig handed over with its datasheet (issue 43): right when
+    the diagnosis answers its truth (a null: none; a slow valve: its delay, ω_n and ζ)."""
+    started = time.perf_counter()
+    sheet = independent.datasheet_of(Path(folder))
+    result = diagnose(read_runs([Path(folder)]).runs,
+                      load_parameters([sheet] if sheet else None, over_reference=True))
+    ok, outcome = independent.judge_datasheet(
+        result.to_json(), result.extended.number(K.ACTUATOR_NATURAL_FREQUENCY_HZ),
+        result.extended.number(K.ACTUATOR_DAMPING_RATIO), Path(folder))
+    return {"cause": f"datasheet ({Path(folder).name})", "seed": Path(folder).name,
+            "ok": ok, "verdict": outcome[:30], "outcome": outcome, "error": None,
+            "seconds": round(time.perf_counter() - started, 1)}
+
+
 def _line(row: dict) -> str:
     error = math.nan if row["error"] is None else row["error"]
     return (f"{row['cause']:40s} {row['seed']:>24s} {row['verdict']:30s} {error:10.3g} "
@@ -413,6 +428,9 @@ def main() -> None:
     unseen = [Task(f"unseen-{folder.name}", unseen_task, (str(folder), equation))
               for folder in independent.campaigns(args.unseen)
               if (equation := independent.unseen_equation(folder)) is not None]
+    unseen += [Task(f"datasheet-{folder.name}", datasheet_task, (str(folder),))
+               for folder in independent.campaigns(args.unseen)
+               if independent.datasheet_of(folder) is not None]
     if not theirs:
         print(f"{args.independent}: no independent campaigns, skipped", file=sys.stderr)
     journal = args.journal or Path("out/detection") / f"seed-{args.seed}{suffix}.jsonl"
@@ -423,8 +441,8 @@ def main() -> None:
         print(f"unseen {row['cause']:40s} {'yes' if row['ok'] else 'NO':>4s}  "
               f"{row['outcome']}  ({row['seconds']:.0f} s)")
     for title, tasks in (("own generator", own), ("independent simulator", theirs),
-                         ("unseen effects (issue 41: discovered in the right equation)",
-                          unseen)):
+                         ("unseen effects (issue 41: discovered in the right equation; "
+                          "issue 43: another rig with its datasheet)", unseen)):
         rows = [results[t.key] for t in tasks if t.key in results]
         if rows:
             report(title, rows)

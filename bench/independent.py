@@ -138,3 +138,35 @@ def judge_unseen(result: dict, equation: str) -> tuple[bool, str]:
     if any(f["cause"] == "unexplained" and f.get("equation") == equation for f in findings):
         return False, f"unexplained, naming the {equation}"
     return False, result["verdict"]
+
+
+def datasheet_of(campaign: Path) -> Path | None:
+    """The campaign's datasheet (a params file naming what differs from the reference rig),
+    None when it has none (issue 43)."""
+    path = campaign / "datasheet.yaml"
+    return path if path.is_file() else None
+
+
+TOLERANCE = 0.1  # relative, of the datasheet-plus-truth values (issue 43)
+
+
+def judge_datasheet(result: dict, natural_frequency_hz: float, damping_ratio: float,
+                    campaign: Path) -> tuple[bool, str]:
+    """Whether a diagnosis with the campaign's datasheet answered its truth: ``none`` for a
+    null on another rig; for a slow valve, its delay, and the final model's ω_n and ζ,
+    within TOLERANCE."""
+    truth = json.loads((campaign / "truth.json").read_text(encoding="utf-8"))
+    wanted = truth["effect"]["equation"]
+    if wanted == "none":
+        return result["verdict"] == "none", result["verdict"]
+    cause = wanted.split()[0]
+    delay = truth["effect_parameters_si"]["act_delay"]
+    found = next((f["parameters"].get("delay_s") for f in result["findings"]
+                  if f["cause"] == cause), None)
+    rig = truth["rig_si"]
+    errors = {"delay": None if found is None else found / delay - 1,
+              "ω_n": natural_frequency_hz * 2 * math.pi / rig["act_wn"] - 1,
+              "ζ": damping_ratio / rig["act_zeta"] - 1}
+    ok = all(e is not None and abs(e) <= TOLERANCE for e in errors.values())
+    shown = ", ".join(f"{k} {'-' if e is None else f'{e:+.1%}'}" for k, e in errors.items())
+    return ok, f"{result['verdict']}: {shown}"

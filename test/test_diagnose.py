@@ -322,20 +322,21 @@ def test_one_braking_run_is_inconclusive_not_none(reference, delay_campaign):
     assert "actuator_delay: not identifiable: no actuator step/sweep run" in _notes(result)
 
 
-def test_actuator_runs_alone_name_the_delay_but_leave_the_verdict_open(reference,
-                                                                       delay_campaign):
+def test_actuator_runs_alone_name_the_delay_held_out_in_time(reference, delay_campaign):
     """Actuator runs only once gave "unexplained lag 3.6 ms, no candidate explains" while
-    actuator_delay had scored ΔBIC −3547: contradictory, and unchecked."""
+    actuator_delay had scored ΔBIC −3547: contradictory, and unchecked; then `inconclusive`
+    with no run left to check it on. The steps' later part is now held out in time (issue
+    43): a verdict with a held-out gain, the braking candidates noted as not tested."""
     runs, rig = delay_campaign
     result = diagnose([runs["actuator_ramp"], runs["actuator_steps_sweep"]], reference)
-    assert result.verdict == "inconclusive"
+    assert result.verdict == "actuator_delay"
     assert not any(f.cause == "unexplained" for f in result.findings)
-    notes = _notes(result)
-    assert "actuator_delay (delay_s 0.00" in notes and "no run is left to check it on" in notes
-    assert "tire_relaxation: not identifiable: no braking run" in notes
-    scored = next(f for f in result.candidates if f.cause == "actuator_delay")
-    assert scored.parameters["delay_s"] == pytest.approx(rig.number("actuator.delay_s"),
-                                                         abs=1e-3)
+    finding = result.findings[0]
+    assert finding.held_out is not None and finding.held_out < 0
+    assert any(name.endswith("(after)") for name in finding.checked_on)
+    assert finding.parameters["delay_s"] == pytest.approx(rig.number("actuator.delay_s"),
+                                                          abs=1e-3)
+    assert "tire_relaxation: not identifiable: no braking run" in _notes(result)
 
 
 def test_braking_runs_alone_claim_no_valve_effect_and_end(reference, delay_campaign):

@@ -157,11 +157,12 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
                 problems.append(outcome)
             else:
                 scored.append(outcome)
-        table.extend(s.finding for s in scored)
         winners = [s for s in scored if s.finding.accepted]
-        if not winners:
+        best = min(winners, key=lambda s: s.finding.delta_bic or 0.0) if winners else None
+        table.extend(replace(s.finding, round=round_, reason=_round_reason(s, best))
+                     for s in scored)
+        if best is None:
             break
-        best = min(winners, key=lambda s: s.finding.delta_bic or 0.0)
         say(f"accepted {best.finding.cause}: {best.finding.evidence}")
         accepted.append(best)
         say(f"re-calibrating with {', '.join(s.finding.cause for s in accepted)}")
@@ -223,6 +224,15 @@ def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],
         else:
             testable.append(candidate)
     return testable, [c for c in skipped if _could_show(CATALOGUE[c], runs)]
+
+
+def _round_reason(scored: Scored, best: Scored | None) -> str:
+    """A candidate's reason in its round: one that meets every rule but another explained
+    more is tried again in the next round, on the model with that one."""
+    if best is None or scored is best or not scored.finding.accepted:
+        return scored.finding.reason
+    return (f"meets every rule, but {best.finding.cause} explains more (ΔBIC "
+            f"{best.finding.delta_bic:+.0f}): tried again on the model with it")
 
 
 def _could_show(candidate: Candidate, runs: Sequence[ClassifiedRun]) -> bool:

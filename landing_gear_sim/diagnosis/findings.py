@@ -54,6 +54,10 @@ class Finding:
     ``wheel channel``, ..."""
     channel: str = ""
     """An ``unexplained`` finding: the measured channel its evidence was found in."""
+    reason: str = ""
+    """A scored candidate: why it was accepted or not, by the first rule it met or failed."""
+    round: int = 0
+    """A scored candidate: the round of the search it was scored in (0: the discovery's)."""
 
     def to_json(self) -> dict[str, object]:
         document: dict[str, object] = {"cause": self.cause, "parameters": self.parameters,
@@ -61,6 +65,8 @@ class Finding:
                     "fit_before": self.fit_before, "fit_after": self.fit_after,
                     "delta_bic": self.delta_bic, "held_out_delta": self.held_out,
                     "fitted_on": list(self.fitted_on), "checked_on": list(self.checked_on)}
+        if self.reason:
+            document |= {"reason": self.reason, "round": self.round}
         if self.family:
             document |= {"family": self.family, "term": self.term}
         if self.equation:

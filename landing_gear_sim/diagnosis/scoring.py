@@ -172,9 +172,8 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
     at_bound = _at_bound(candidate, with_it)
     beyond = candidate.reach(with_it.values, fit_runs, with_it.params) if candidate.reach \
         else ""
-    accepted = (delta_bic < BIC_THRESHOLD and held.delta is not None
-                and held.delta < HELD_OUT_THRESHOLD and held.gain >= MIN_GAIN_POINTS
-                and not at_bound and not beyond)
+    reason = _reason(delta_bic, held, at_bound, beyond)
+    accepted = reason.startswith("meets")
     parameters = key_parameters(candidate, with_it.params)
     std = key_std(candidate, with_it)
     evidence = _evidence(candidate, delta_bic, held, fit_runs, held_runs, signatures) \
@@ -185,8 +184,29 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
                       delta_bic=round(delta_bic, 1),
                       held_out=None if held.delta is None else round(held.delta, 1),
                       accepted=accepted, fitted_on=_names(fit_runs),
-                      checked_on=_names(held_runs), family=candidate.family)
+                      checked_on=_names(held_runs), family=candidate.family, reason=reason)
     return Scored(finding, with_it)
+
+
+def _reason(delta_bic: float, held: HeldOut, at_bound: bool, beyond: str) -> str:
+    """Why a candidate is accepted or not, in words: the first of the rules it fails, or
+    that it meets them all (a 'no' beside numbers that seem to meet the stated rule once
+    had no reason: its gain on the channel it helps was below MIN_GAIN_POINTS)."""
+    if delta_bic >= BIC_THRESHOLD:
+        return f"no: ΔBIC {delta_bic:+.0f} is not below {BIC_THRESHOLD:g}"
+    if held.delta is None:
+        return "no: no held-out run to check it on"
+    if held.delta >= HELD_OUT_THRESHOLD:
+        return (f"no: the held-out runs improve by {-held.delta:+.0f}, not by more than "
+                f"{-HELD_OUT_THRESHOLD:g}")
+    if held.gain < MIN_GAIN_POINTS:
+        return (f"no: it gains {held.gain:.2f} fit-% points on the held-out runs' channel it "
+                f"helps most, below {MIN_GAIN_POINTS:g}")
+    if at_bound:
+        return "no: a key parameter sits at the edge of its range"
+    if beyond:
+        return f"no: {beyond}"
+    return "meets every rule (ΔBIC, held-out gain, parameters within range)"
 
 
 @dataclass(frozen=True)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import html
 import textwrap
+from collections import Counter
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -179,9 +180,9 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
           _text(f.delta_bic), _text(_gain(f.held_out)), fits(f.fit_before), fits(f.fit_after),
           f.evidence] for f in result.findings])
     candidates = html_table(
-        ["cause", "accepted", "key parameters", "ΔBIC", "held-out improvement", "fitted on",
-         "checked on"],
-        [[f.cause, "yes" if f.accepted else "no",
+        ["round", "cause", "accepted", "why", "key parameters", "ΔBIC", "held-out improvement",
+         "fitted on", "checked on"],
+        [[str(f.round or "discovery"), f.cause, "yes" if f.accepted else "no", f.reason,
           ", ".join(f"{k} = {v:.4g}" for k, v in f.parameters.items()), _text(f.delta_bic),
           _text(_gain(f.held_out)), ", ".join(f.fitted_on), ", ".join(f.checked_on)]
          for f in result.candidates])
@@ -240,10 +241,25 @@ def _consistency_section(calibrated: Sequence[Check], extended: Sequence[Check],
 
 def paired_checks(calibrated: Sequence[Check], extended: Sequence[Check]
                   ) -> list[tuple[Check | None, Check]]:
-    """Each check of the extended model with the same relation on the same run under the
-    calibrated model (None where that one was not made)."""
-    first = {(c.relation, c.run): c for c in calibrated}
-    return [(first.get((c.relation, c.run)), c) for c in extended]
+    """Each check of the extended model with the check of the calibrated model that measures
+    the same: the same relation, run and phase (a relation checked twice on a run, as "no
+    contact ⇒ no load" on F_x and on F_z, is two checks), or, where the phase names what
+    each model's fit kept (an equation's terms), the one check of that relation and run;
+    None where that one was not made. (Paired by relation and run alone, F_z's −0.60 N had
+    stood beside F_x's −0.28 N as if one had become the other.)"""
+    exact = {(c.relation, c.run, c.phase): c for c in calibrated}
+    alone: dict[tuple[Relation, str], list[Check]] = {}
+    for c in calibrated:
+        alone.setdefault((c.relation, c.run), []).append(c)
+    after = Counter((c.relation, c.run) for c in extended)
+
+    def before(check: Check) -> Check | None:
+        key = (check.relation, check.run)
+        same = alone.get(key, [])
+        return exact.get((*key, check.phase)) or (
+            same[0] if len(same) == 1 and after[key] == 1 else None)
+
+    return [(before(c), c) for c in extended]
 
 
 def _check_cell(check: Check | None) -> str:
@@ -328,12 +344,12 @@ def _gain(held_out: float | None) -> float | None:
 
 def diagnosis_summary(result: Diagnosis) -> str:
     """The terminal summary: candidates, baseline fit, verdict, findings, notes."""
-    rows = [[f.cause, "yes" if f.accepted else "no", _maybe(f.delta_bic),
-             _maybe(_gain(f.held_out)),
-             f"{_fits(f.fit_before)} -> {_fits(f.fit_after)}"]
+    rows = [[str(f.round or "disc."), f.cause, "yes" if f.accepted else "no",
+             _maybe(f.delta_bic), _maybe(_gain(f.held_out)),
+             f"{_fits(f.fit_before)} -> {_fits(f.fit_after)}", f.reason]
             for f in result.candidates]
-    lines = ["candidates:", text_table(["cause", "accepted", "dBIC", "held-out gain",
-                                        "held-out fit %"],
+    lines = ["candidates:", text_table(["round", "cause", "accepted", "dBIC", "held-out gain",
+                                        "held-out fit %", "why"],
                                        rows) if rows else "  (none: the model has them all)"]
     lines.append(f"baseline fit %: {_fits(result.baseline)}")
     lines.append(f"VERDICT: {verdict_text(result)}")

@@ -47,3 +47,18 @@ def test_every_candidate_says_why_it_was_or_was_not_accepted():
     assert "no held-out run" in _reason(-97.0, HeldOut(), False, "")
     assert "edge of its range" in _reason(-97.0, HeldOut(delta=-50.0, gain=2.0), True, "")
     assert _reason(-97.0, HeldOut(delta=-50.0, gain=2.0), False, "").startswith("meets")
+
+
+def test_the_consistency_chart_colours_only_what_the_verdict_calls_violated(tmp_path):
+    """'vertical load follows F_z0 − k_L v²' drawn orange at 13σ past the 6σ line beside a
+    verdict of 0 violated (its deviation was under the physical floor). Each bar is now its
+    deviation over max(6σ, floor): past 1 exactly when violated, and only then red."""
+    from landing_gear_sim.report.diagnosis import _colour, reach
+
+    under_floor = Check(Relation.LOADING_LAW, "campaign", "settled", 130.0, 10.0, 150.0, "N")
+    violated = Check(Relation.LOADING_LAW, "campaign", "settled", 300.0, 10.0, 150.0, "N")
+    within_sigma = Check(Relation.LOADING_LAW, "campaign", "settled", 50.0, 10.0, 1.0, "N")
+    assert under_floor.z > 6 and not under_floor.violated
+    for check in (under_floor, violated, within_sigma):
+        assert (reach(check) > 1.0) == check.violated
+        assert (_colour(check) == "tab:red") == check.violated

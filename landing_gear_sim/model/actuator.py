@@ -9,10 +9,10 @@ State: pressure [Pa] and its rate [Pa/s], driven by the static-map pressure [Pa]
 
 A(s) holds the valve's generic slot (``actuator.term_*``, ``model.basis``): a term
 Σ c_k φ_k(P, Ṗ, ΔP) [Pa] beside the static pressure it is driven by,
-P̈ = ω_n² (μ P_static + Σ c_k φ_k − P) − 2 ξ ω_n Ṗ, with ΔP = μ P_static − P: a spool
-that sticks (c sgn ΔP), a valve stiffer at pressure (c P·ΔP). It acts undelayed, held over
-a step at the mean of its values at the step's two ends, through the unit-gain input
-matrix.
+P̈ = ω_n² (μ P_static + Σ c_k φ_k − P) − 2 ξ ω_n Ṗ, with ΔP = μ P_static − P: a spool's
+friction (c sgn Ṗ; memoryless, so no stick-slip: at rest it chatters onto the map), a valve
+stiffer at pressure (c P·ΔP). It acts undelayed, held over a step at the mean of its values
+at the step's two ends, through the unit-gain input matrix.
 """
 
 from __future__ import annotations
@@ -194,7 +194,6 @@ def settled_states(p, matrices, current):
             actuator_step(p, matrices, xa, current[k])
         out[k, 2] = xa[newest]
     return out
-
 
 
 def actuator_pressure(params: RigParameters, current_a: np.ndarray, rate_hz: float

@@ -5,6 +5,7 @@ spectrum of the starting model; and the summary printed on the terminal."""
 from __future__ import annotations
 
 import html
+import math
 import textwrap
 from collections import Counter
 from collections.abc import Sequence
@@ -231,8 +232,9 @@ def _consistency_section(calibrated: Sequence[Check], extended: Sequence[Check],
     shown = worst_per_relation(pairs)
     caption = (f"<p>A relation is violated when its deviation is beyond {Z_VIOLATED:g} σ "
                "<i>and</i> beyond its physical floor (the size below which it does not matter "
-               "to the rig, last column): an orange bar is beyond the σ line but within its "
-               f"floor. The chart shows each of the {len(shown)} relations checked once, on its "
+               "to the rig, last column): the chart draws each deviation over the larger of "
+               "the two, so a bar past 1 (red) is a violation and no other is. The chart "
+               f"shows each of the {len(shown)} relations checked once, on its "
                f"worst run; the table all {len(pairs)} checks.</p>")
     figure = plot_consistency(shown, folder / "consistency.png") if shown else None
     image = html_image(figure, folder) if figure else ""
@@ -278,27 +280,30 @@ def worst_per_relation(pairs: Sequence[Pair]) -> list[tuple[Pair, int]]:
     by_relation: dict[Relation, list[Pair]] = {}
     for pair in pairs:
         by_relation.setdefault(pair[1].relation, []).append(pair)
-    return [(max(group, key=lambda p: max(_sigmas(p[0]), _sigmas(p[1]))), len(group))
+    return [(max(group, key=lambda p: max(reach(p[0]), reach(p[1]))), len(group))
             for group in by_relation.values()]
 
 
 def plot_consistency(rows: Sequence[tuple[Pair, int]], path: Path) -> Path:
     """Each relation's worst check (``rows``: see :func:`worst_per_relation`), its deviation
-    in σ (log scale) under the calibrated model (pale) and the extended one, against the
-    violation threshold; red: violated, orange: over the threshold but under its floor."""
+    over its threshold (log scale: :func:`reach`) under the calibrated model (pale) and the
+    extended one; past 1 the check is violated, and red. (Drawn in σ against the 6σ line,
+    a relation 13σ out but under its physical floor had read as violated beside a verdict
+    that said none was.)"""
     pairs = [pair for pair, _ in rows]
-    fig, ax = plt.subplots(figsize=(9, 0.22 * len(pairs) + 1.3))  # 17 relations in 600 px
+    fig, ax = plt.subplots(figsize=(9, 0.22 * len(pairs) + 1.3))  # 18 relations in 600 px
     rows_at = np.arange(len(pairs))
     for offset, alpha, index in ((-0.2, 0.4, 0), (0.2, 1.0, 1)):
         checks = [pair[index] for pair in pairs]
-        ax.barh(rows_at + offset, [_sigmas(c) for c in checks], height=0.4, alpha=alpha,
+        ax.barh(rows_at + offset, [reach(c) for c in checks], height=0.4, alpha=alpha,
                 color=[_colour(c) for c in checks])
-    ax.axvline(Z_VIOLATED, color="k", linestyle="--")
+    ax.axvline(1.0, color="k", linestyle="--")
     keys: list[matplotlib.artist.Artist] = [
         matplotlib.patches.Patch(color="tab:grey", alpha=a, label=label)
         for a, label in ((0.4, "calibrated model"), (1.0, "extended model"))]
+    keys.append(matplotlib.patches.Patch(color="tab:red", label="violated"))
     keys.append(matplotlib.lines.Line2D([], [], color="k", linestyle="--",
-                                        label=f"{Z_VIOLATED:g} σ"))
+                                        label=f"threshold: {Z_VIOLATED:g} σ or\nthe floor"))
     ax.set_xscale("log")
     ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     # wrapped: a long relation's first letters were cut off at the figure's edge
@@ -306,20 +311,26 @@ def plot_consistency(rows: Sequence[tuple[Pair, int]], path: Path) -> Path:
                                           + (f" (worst of {count})" if count > 1 else ""), 44)
                             for (_, after), count in rows], fontsize=7)
     ax.invert_yaxis()
-    ax.set_xlabel("|deviation| / σ (red: violated; orange: over σ but under its physical floor)")
-    ax.legend(handles=keys, loc="lower right", fontsize=7)
+    ax.set_xlabel(f"|deviation| / max({Z_VIOLATED:g} σ, the relation's physical floor)")
+    # off the data: the bars' ends were under it
+    ax.legend(handles=keys, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
     fig.tight_layout()
     return save_figure(fig, path)
 
 
-def _sigmas(check: Check | None) -> float:
-    return 0.0 if check is None else max(min(check.z, 1e4), 1e-2)
+def reach(check: Check | None) -> float:
+    """How far a check's deviation goes towards its violation: |deviation| over the larger
+    of Z_VIOLATED σ and the relation's physical floor (past 1: violated), clipped for a log
+    axis; 0 where the check was not made."""
+    if check is None:
+        return 0.0
+    threshold = max(Z_VIOLATED * check.std, check.floor)
+    ratio = abs(check.deviation) / threshold if threshold > 0 else math.inf
+    return max(min(ratio, 1e4), 1e-2)
 
 
 def _colour(check: Check | None) -> str:
-    if check is None or not check.z > Z_VIOLATED:
-        return "tab:grey"
-    return "tab:red" if check.violated else "tab:orange"
+    return "tab:red" if check is not None and check.violated else "tab:grey"
 
 
 def _datasheet(params: RigParameters) -> str:

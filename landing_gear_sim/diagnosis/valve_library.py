@@ -148,12 +148,12 @@ def _owned(params: RigParameters) -> tuple[str, ...]:
 
 def _moved(params: RigParameters, codes: list[int], values: np.ndarray, owned: np.ndarray
            ) -> RigParameters | None:
-    """``params`` with the terms ``codes`` at ``values`` in A(s)'s slot and the owned
-    parameters moved by ``owned`` (None: a step out of their bounds)."""
+    """``params`` with the terms ``codes`` at ``values`` in the free places of A(s)'s slot
+    and the owned parameters moved by ``owned`` (None: a step out of their bounds)."""
     changes = {key: params.number(key) + shift for key, shift in zip(_owned(params), owned,
                                                                       strict=True)}
-    for (code_key, coeff_key), code, value in zip(Slot.VALVE.keys, codes, values,
-                                                  strict=False):
+    free = [pair for pair in Slot.VALVE.keys if params.number(pair[1]) == 0.0]
+    for (code_key, coeff_key), code, value in zip(free, codes, values, strict=False):
         changes[code_key], changes[coeff_key] = float(code), float(value)
     try:
         return params.replace(changes, "refined")

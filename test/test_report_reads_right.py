@@ -39,14 +39,14 @@ def test_an_equations_check_pairs_across_the_terms_each_model_kept():
 def test_every_candidate_says_why_it_was_or_was_not_accepted():
     """The rule the page states is ΔBIC and a held-out gain; a candidate that met both was
     marked 'no' with no reason (its gain on the channel it helps was 0.04 fit-% points)."""
-    from landing_gear_sim.diagnosis.scoring import HeldOut, _reason
+    from landing_gear_sim.diagnosis.scoring import HeldOut, _rejection
 
     held = HeldOut(delta=-16.0, gain=0.04)
-    assert "0.04 fit-% points" in _reason(-97.0, held, False, "")
-    assert "ΔBIC +3" in _reason(3.0, held, False, "")
-    assert "no held-out run" in _reason(-97.0, HeldOut(), False, "")
-    assert "edge of its range" in _reason(-97.0, HeldOut(delta=-50.0, gain=2.0), True, "")
-    assert _reason(-97.0, HeldOut(delta=-50.0, gain=2.0), False, "").startswith("meets")
+    assert "0.04 fit-% points" in _rejection(-97.0, held, False, "")
+    assert "ΔBIC +3" in _rejection(3.0, held, False, "")
+    assert "no held-out run" in _rejection(-97.0, HeldOut(), False, "")
+    assert "edge of its range" in _rejection(-97.0, HeldOut(delta=-50.0, gain=2.0), True, "")
+    assert _rejection(-97.0, HeldOut(delta=-50.0, gain=2.0), False, "") == ""
 
 
 def test_the_consistency_chart_colours_only_what_the_verdict_calls_violated(tmp_path):

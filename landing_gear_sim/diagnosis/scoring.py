@@ -172,8 +172,9 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
     at_bound = _at_bound(candidate, with_it)
     beyond = candidate.reach(with_it.values, fit_runs, with_it.params) if candidate.reach \
         else ""
-    reason = _reason(delta_bic, held, at_bound, beyond)
-    accepted = reason.startswith("meets")
+    rejected = _rejection(delta_bic, held, at_bound, beyond)
+    accepted = not rejected
+    reason = rejected or ACCEPTED
     parameters = key_parameters(candidate, with_it.params)
     std = key_std(candidate, with_it)
     evidence = _evidence(candidate, delta_bic, held, fit_runs, held_runs, signatures) \
@@ -188,10 +189,13 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
     return Scored(finding, with_it)
 
 
-def _reason(delta_bic: float, held: HeldOut, at_bound: bool, beyond: str) -> str:
-    """Why a candidate is accepted or not, in words: the first of the rules it fails, or
-    that it meets them all (a 'no' beside numbers that seem to meet the stated rule once
-    had no reason: its gain on the channel it helps was below MIN_GAIN_POINTS)."""
+ACCEPTED = "meets every rule (ΔBIC, held-out gain, parameters within range)"
+
+
+def _rejection(delta_bic: float, held: HeldOut, at_bound: bool, beyond: str) -> str:
+    """Why a candidate is not accepted, in words: the first of the rules it fails ('': it
+    meets them all; a 'no' beside numbers that seem to meet the stated rule once had no
+    reason: its gain on the channel it helps was below MIN_GAIN_POINTS)."""
     if delta_bic >= BIC_THRESHOLD:
         return f"no: ΔBIC {delta_bic:+.0f} is not below {BIC_THRESHOLD:g}"
     if held.delta is None:
@@ -206,7 +210,7 @@ def _reason(delta_bic: float, held: HeldOut, at_bound: bool, beyond: str) -> str
         return "no: a key parameter sits at the edge of its range"
     if beyond:
         return f"no: {beyond}"
-    return "meets every rule (ΔBIC, held-out gain, parameters within range)"
+    return ""
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,7 @@ the project: ``msg_tools`` and ``antiskid`` derive their errors from it too.
     ├── ScenarioError           a run cannot be built (profile, level, recorded input)
     ├── IdentificationError     the runs cannot support a calibration or candidate fit
     ├── DiagnosisError          a campaign cannot be diagnosed at all
+    ├── ComparisonError         two runs share too little time to be compared
     ├── GraphError              the node graph cannot be configured or started
     ├── msg_tools.RunFormatError     a run file is unreadable or breaks the data contract
     └── antiskid.ControllerError     controller settings that cannot work
@@ -39,6 +40,10 @@ class IdentificationError(LandingGearSimError, ValueError):
 
 class DiagnosisError(LandingGearSimError, ValueError):
     """The campaign cannot be diagnosed (no usable runs, unknown element)."""
+
+
+class ComparisonError(LandingGearSimError, ValueError):
+    """A simulated and a measured run share too little time to be compared."""
 
 
 class GraphError(LandingGearSimError):

@@ -14,7 +14,7 @@ from .columns import run_from_table
 from .csv_io import read_csv, read_named, run_name
 from .errors import RunFormatError
 from .mapping import Mapping
-from .run import Run
+from .run import SIGNALS, Run
 from .timebase import split_at_gaps
 from .workbook import SUFFIXES as WORKBOOK_SUFFIXES
 from .workbook import read_workbook
@@ -89,22 +89,42 @@ class Campaign:
     problems: tuple[str, ...]
 
 
-def campaign_sources(folder: Path) -> list[Path]:
+def campaign_sources(folder: Path, skipped: list[str] | None = None) -> list[Path]:
     """Run files and bags in ``folder`` and its sub-folders, sorted; hidden entries
-    (``.name``, macOS ``._name``) and files such as configs and reports left out."""
+    (``.name``, macOS ``._name``) and files such as configs and reports left out. A link
+    is followed once: an entry reaching a folder or file already read is left out, and
+    said in ``skipped`` (a link to the folder itself once recursed 82 levels deep)."""
     folder = Path(folder)
     if not folder.is_dir():
         raise RunFormatError(f"{folder}: not a folder")
     found: list[Path] = []
+    _sources(folder, {folder.resolve()}, found, skipped if skipped is not None else [])
+    return found
+
+
+def _sources(folder: Path, seen: set[Path], found: list[Path], skipped: list[str]) -> None:
     for entry in sorted(folder.iterdir()):
         if entry.name.startswith(".") or entry.name == "__MACOSX":
             continue
         kind = _kind(entry)
+        if kind == "other" and not entry.is_dir():
+            continue
+        real = entry.resolve()
+        if entry.is_symlink() and (real in seen or (entry.is_dir() and _tangled(real, seen))):
+            skipped.append(f"{entry}: a link to {real}, already read (links are followed "
+                           "once)")
+            continue
+        seen.add(real)
         if entry.is_dir() and kind != "bag":
-            found.extend(campaign_sources(entry))
-        elif kind != "other":
+            _sources(entry, seen, found, skipped)
+        else:
             found.append(entry)
-    return found
+
+
+def _tangled(real: Path, seen: set[Path]) -> bool:
+    """Whether a linked folder ``real`` holds a folder already read (a loop) or lies in one
+    (read there anyway)."""
+    return any(real in p.parents or p in real.parents for p in seen)
 
 
 def read_campaign(folder: Path, mapping: Mapping | None = None,
@@ -114,7 +134,7 @@ def read_campaign(folder: Path, mapping: Mapping | None = None,
     folder = Path(folder)
     runs: list[Run] = []
     problems: list[str] = []
-    sources = campaign_sources(folder)
+    sources = campaign_sources(folder, problems)
     for number, source in enumerate(sources, 1):
         if progress and len(sources) > 1:
             progress(f"reading {number}/{len(sources)}: {source.relative_to(folder)}")
@@ -175,19 +195,17 @@ def resample(run: Run, rate_hz: float) -> Run:
     """``run`` on a uniform time base from its first sample (linear; current held)."""
     start = float(run.time_s[0])
     n = int(np.floor((run.time_s[-1] - start) * rate_hz + 1e-9)) + 1
-    base = start + np.arange(n) / rate_hz
-    held = np.clip(np.searchsorted(run.time_s, base + 1e-12, side="right") - 1, 0, None)
+    return at_times(run, start + np.arange(n) / rate_hz)
 
-    def linear(values: np.ndarray) -> np.ndarray:
-        return np.interp(base, run.time_s, values)
 
-    return Run(
-        name=run.name, source=run.source, time_s=base, current_a=run.current_a[held],
-        pressure_pa=linear(run.pressure_pa), wheel_speed_rad_s=linear(run.wheel_speed_rad_s),
-        flywheel_speed_rad_s=linear(run.flywheel_speed_rad_s),
-        vertical_load_n=linear(run.vertical_load_n),
-        longitudinal_force_n=linear(run.longitudinal_force_n),
-    )
+def at_times(run: Run, times_s: np.ndarray) -> Run:
+    """``run``'s signals at ``times_s`` (on its own clock, within its span): linear between
+    its samples, the current held (a command steps, it does not ramp)."""
+    held = np.clip(np.searchsorted(run.time_s, times_s + 1e-12, side="right") - 1, 0, None)
+    linear = {name: np.interp(times_s, run.time_s, getattr(run, name))
+              for name in SIGNALS if name != "current_a"}
+    return Run(name=run.name, source=run.source, time_s=times_s, current_a=run.current_a[held],
+               **linear)
 
 
 def is_uniform(run: Run, tolerance: float = 1e-6) -> bool:

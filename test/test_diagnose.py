@@ -181,6 +181,21 @@ def test_relaxation_is_fitted_on_constant_stops_or_else_on_any_braking_run(refer
     assert {r.name for r in fit + held} == {r.name for r in oscillating}
 
 
+def test_the_run_of_a_class_that_slides_furthest_is_fitted_not_held_out(reference, tmp_path):
+    # a held-out run beyond every fitted slip tests extrapolation no friction law passes
+    # (U01: a magic-formula tyre fitted below 0.15 slip, checked on a stop sliding to 0.6)
+    runs, _ = _campaign(reference, tmp_path, 114)
+    oscillating = sorted((r for r in runs if r.name.startswith("brake_osc")), key=len)
+    longer = oscillating[-1]
+    braked = np.flatnonzero(longer.current_a > 0.5 * longer.current_a.max())
+    wheel = longer.wheel_speed_rad_s.copy()
+    wheel[braked[len(braked) // 2: len(braked) // 2 + 200]] = 0.0  # a locked wheel
+    oscillating[-1] = dataclasses.replace(longer, wheel_speed_rad_s=wheel)
+    fit, held = split_runs(CATALOGUE["tire_relaxation"], oscillating)
+    assert [r.name for r in fit] == [longer.name]
+    assert [r.name for r in held] == [oscillating[0].name]
+
+
 def test_unknown_element_to_remove_is_a_clear_error(reference, tmp_path):
     runs, _ = _campaign(reference, tmp_path, 108)
     with pytest.raises(DiagnosisError, match="not a model element"):

@@ -356,3 +356,69 @@ def test_a_long_text_run_read_from_the_open_file_is_the_run_read_whole(tmp_path,
             np.testing.assert_array_equal(a, b, err_msg=field.name)
         else:
             assert a == b, field.name
+
+
+def test_compare_puts_a_log_at_another_rate_on_the_simulations_time_base(tmp_path, csv_file,
+                                                                          capsys):
+    """Issue 43: a 100 Hz log against a 1 kHz simulation was compared sample by sample (the
+    simulated trace stretched ten times, fits of −65 to −117 %)."""
+    slow = tmp_path / "slow.csv"
+    write_csv(resample(read_csv(csv_file), 100.0), slow)
+    assert main(["compare", str(slow), str(csv_file), "--plot", str(tmp_path / "c.png")]) == 0
+    out = capsys.readouterr()
+    wheel = next(line for line in out.out.splitlines()
+                 if line.lstrip().startswith("wheel_speed_rad_s"))
+    assert float(wheel.split()[1]) > 95.0
+    assert "100 Hz" in out.err and "1000 Hz" in out.err
+
+
+def test_compare_says_it_scores_only_the_span_both_runs_cover(tmp_path, csv_file, capsys):
+    run = read_csv(csv_file)
+    shorter = tmp_path / "shorter.csv"
+    write_csv(run.part(slice(0, len(run) // 2), run.name), shorter)
+    assert main(["compare", str(csv_file), str(shorter), "--plot", str(tmp_path / "c.png")]) == 0
+    out = capsys.readouterr()
+    assert "compared over the first 1.5 s" in out.err
+    assert "100.00" in out.out
+
+
+@pytest.mark.parametrize("command", ["compare", "validate"])
+def test_a_pressure_logged_in_mpa_is_named_before_any_score(tmp_path, csv_file, command,
+                                                             capsys):
+    """Issue 43: compare and validate gave fits of −1800 % to −600,000 % on a pressure in MPa
+    under a bar header with no hint (metrics named MPa on the same file)."""
+    folder = tmp_path / "campaign"
+    folder.mkdir()
+    run = read_csv(csv_file)
+    write_csv(dataclasses.replace(run, pressure_pa=run.pressure_pa / 10.0),
+              folder / "brake_osc_low.csv")  # MPa numbers in the bar column
+    given = [str(folder / "brake_osc_low.csv"), str(csv_file), "--plot",
+             str(tmp_path / "c.png")] if command == "compare" else [
+        str(folder), "--report", str(tmp_path / "report")]
+    assert main([command, *given]) == 2
+    err = capsys.readouterr().err
+    assert "brake_pressure_bar" in err and "MPa" in err and "Traceback" not in err
+
+
+def test_a_folder_linking_to_itself_is_read_once(tmp_path, csv_file):
+    """Issue 43: validate recursed 82 runs deep into a symlink to the folder itself and died
+    on 'File name too long' after writing 81 files."""
+    folder = tmp_path / "campaign"
+    folder.mkdir()
+    shutil.copy(csv_file, folder / "brake_osc_low.csv")
+    (folder / "again").symlink_to(folder, target_is_directory=True)
+    campaign = read_campaign(folder)
+    assert [r.name for r in campaign.runs] == ["brake_osc_low"]
+    assert any("again" in p and "already read" in p for p in campaign.problems)
+
+
+def test_validate_says_which_files_of_a_campaign_it_skipped(tmp_path, csv_file, capsys):
+    """Issue 43: validate dropped three unreadable files without a word (identify lists
+    them)."""
+    folder = tmp_path / "campaign"
+    folder.mkdir()
+    shutil.copy(csv_file, folder / "brake_osc_low.csv")
+    (folder / "brake_const_20bar.csv").write_text("time_s,current_ref_A\n0,1\n")
+    assert main(["validate", str(folder), "--report", str(tmp_path / "report")]) == 0
+    err = capsys.readouterr().err
+    assert "skipped" in err and "brake_const_20bar.csv" in err

@@ -44,6 +44,7 @@ LATTICE_LEVELS = 3  # ... and at least this many
 def check_units(runs: Sequence[ClassifiedRun], params: RigParameters) -> None:
     """Raise :class:`IdentificationError` naming the column and its likely unit."""
     for run in runs:
+        _check_load(run, params)  # first: a load in kN reads as a wheel never on the flywheel
         _check_speeds(run, params)
         _check_pressure(run, params)
         _check_momentum(run, params)
@@ -54,7 +55,7 @@ def unit_notes(runs: Sequence[ClassifiedRun], params: RigParameters) -> list[str
     a clipping pressure transducer, a counted wheel channel and its resolution (each a
     note; empty: nothing)."""
     return [note for note in (_absolute_pressure(runs), _clipped_pressure(runs, params),
-                              _counted_wheel(runs)) if note]
+                              _counted_wheel(runs), _other_load(runs, params)) if note]
 
 
 def _absolute_pressure(runs: Sequence[ClassifiedRun]) -> str | None:
@@ -142,6 +143,44 @@ def _refuse(run: ClassifiedRun, column: str, ratio: float, what: str, unit: str 
            "or a column mapping)" if unit else "; check its unit and the rig parameters"
     raise IdentificationError(f"{run.source or run.name}: {column} is {ratio:.3g} times "
                               f"{what}{hint}")
+
+
+CERTAIN_FACTOR = 10.0  # a datasheet value off by this is a unit, not another rig
+LOAD_PERCENTILE = 95.0  # a stop's load near its static set point (lift takes from it at speed)
+
+
+def _load_ratio(run: ClassifiedRun, params: RigParameters) -> float | None:
+    """A braking run's load near its set point over the rig's static load (None: not a
+    braking run)."""
+    if not run.braking:
+        return None
+    static = params.number(K.LOADING_STATIC_LOAD_N)
+    return float(np.percentile(run.vertical_load_n, LOAD_PERCENTILE)) / static
+
+
+def _check_load(run: ClassifiedRun, params: RigParameters) -> None:
+    """A load whose ratio to the datasheet's static load is a unit's factor at least
+    CERTAIN_FACTOR from 1 (kN; a load in lbf reads like a rig 4.4 times lighter); any other
+    disagreement is the datasheet's to settle (:func:`_other_load`, a note)."""
+    ratio = _load_ratio(run, params)
+    if ratio is None or 1.0 / CERTAIN_FACTOR <= ratio <= CERTAIN_FACTOR:
+        return
+    unit = _likely(ratio, "force", "N")
+    if unit:
+        _refuse(run, "vertical_load_N", ratio,
+                f"the rig's static load ({K.LOADING_STATIC_LOAD_N} "
+                f"{params.number(K.LOADING_STATIC_LOAD_N) / 1e3:.3g} kN) near its top", unit)
+
+
+def _other_load(runs: Sequence[ClassifiedRun], params: RigParameters) -> str | None:
+    ratios = [r for r in (_load_ratio(run, params) for run in runs) if r is not None]
+    if not ratios or PLAUSIBLE_RATIO[0] <= float(np.median(ratios)) <= PLAUSIBLE_RATIO[1]:
+        return None
+    return (f"vertical_load_N reads {float(np.median(ratios)):.3g} times the rig's static "
+            f"load ({K.LOADING_STATIC_LOAD_N} "
+            f"{params.number(K.LOADING_STATIC_LOAD_N) / 1e3:.3g} kN) near its top: another "
+            "rig? Name its static load in the datasheet (--config) so the model loads the "
+            "wheel as the rig did")
 
 
 def _check_speeds(run: ClassifiedRun, params: RigParameters) -> None:

@@ -9,7 +9,7 @@ measured frequency response beside the model's.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -17,6 +17,7 @@ from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.actuator import FrfEstimate, actuator_frf
 from landing_gear_sim.calibration.friction import friction_samples
 from landing_gear_sim.calibration.measured import channels_of, simulate_run
+from landing_gear_sim.calibration.plausibility import check_units
 from landing_gear_sim.calibration.runs import (
     Family,
     RunKind,
@@ -24,8 +25,10 @@ from landing_gear_sim.calibration.runs import (
     classify_all,
     select,
 )
+from landing_gear_sim.errors import ComparisonError
 from landing_gear_sim.model.integrate import SimulationResult
 from landing_gear_sim.model.parameters import RigParameters
+from msg_tools.io import at_times
 from msg_tools.run import Run
 
 
@@ -47,6 +50,8 @@ class RunComparison:
     kind: RunKind
     scores: dict[str, Score]
     result: SimulationResult | None = None
+    notes: tuple[str, ...] = ()
+    """How the two were put on one time base, when it took more than matching samples."""
 
 
 @dataclass(frozen=True)
@@ -76,12 +81,43 @@ def score(measured: np.ndarray, simulated: np.ndarray) -> Score:
 
 
 def compare(measured: Run, simulated: Run) -> RunComparison:
-    """Score ``simulated`` against ``measured`` on their common samples (``measured`` on
-    its uniform grid, as classified: the comparison keeps the samples it scored)."""
+    """Score ``simulated`` against ``measured`` over the span both cover, each timed from
+    its own start (a log's clock may read the epoch, a simulation's 0): the simulation at
+    the measured samples (``measured`` on its uniform grid, as classified: the comparison
+    keeps the samples it scored). A 100 Hz log had been matched sample by sample against a
+    1 kHz simulation: the simulated trace stretched ten times."""
     run = classified(measured)
-    n = min(len(run), len(simulated))
-    scores = {c: score(getattr(run, c)[:n], getattr(simulated, c)[:n]) for c in channels_of(run)}
-    return RunComparison(run, simulated, run.kind, scores)
+    simulated, notes = on_time_base(simulated, run)
+    n = len(simulated)
+    scores = {c: score(getattr(run, c)[:n], getattr(simulated, c)) for c in channels_of(run)}
+    return RunComparison(run, simulated, run.kind, scores, notes=notes)
+
+
+SAME_RATE = 0.01  # rates closer than this (relative) are one rate
+
+
+def on_time_base(simulated: Run, measured: Run) -> tuple[Run, tuple[str, ...]]:
+    """``simulated`` at ``measured``'s samples over the span both cover, and what that
+    took (notes); unchanged when the two share their samples."""
+    elapsed = measured.time_s - measured.time_s[0]
+    span = float(simulated.time_s[-1] - simulated.time_s[0])
+    n = int(np.searchsorted(elapsed, span + 0.5 / measured.rate_hz, side="right"))
+    if n == len(simulated) == len(measured) and np.allclose(
+            simulated.time_s - simulated.time_s[0], elapsed, atol=1e-9):
+        return simulated, ()
+    if n < 2:
+        raise ComparisonError(f"{simulated.source or simulated.name} covers {span:.3g} s: "
+                              "less than two of the measured run's samples to compare on")
+    notes = []
+    if abs(simulated.rate_hz / measured.rate_hz - 1.0) > SAME_RATE:
+        notes.append(f"the measured run is logged at {measured.rate_hz:.4g} Hz, the "
+                     f"simulation at {simulated.rate_hz:.4g} Hz: the simulation is compared "
+                     "at the measured samples (linear between its own)")
+    if n < len(measured) or span > elapsed[-1] + 1.0 / measured.rate_hz:
+        notes.append(f"compared over the first {elapsed[n - 1]:.3g} s, the span both cover "
+                     f"(measured {elapsed[-1]:.3g} s, simulated {span:.3g} s)")
+    at = at_times(simulated, simulated.time_s[0] + elapsed[:n])
+    return replace(at, time_s=measured.time_s[:n]), tuple(notes)
 
 
 def validate(runs: Sequence[Run], params: RigParameters) -> list[RunComparison]:
@@ -97,6 +133,7 @@ def validate(runs: Sequence[Run], params: RigParameters) -> list[RunComparison]:
 def validate_campaign(runs: Sequence[Run], params: RigParameters) -> Validation:
     """:func:`validate`, with the friction points and the actuator FRFs of the campaign."""
     classified_runs = classify_all(runs)
+    check_units(classified_runs, params)  # a pressure in MPa had scored −600,000 %
     braking = select(classified_runs, [Family.BRAKE])
     dynamic = select(classified_runs, [RunKind.ACTUATOR_DYNAMIC])
     points = (friction_samples([br.prepare(r, params) for r in braking], params)

@@ -57,6 +57,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     cmp_.add_argument("--plot", type=Path, default=Path("out/compare.png"),
                       help="PNG path (default out/compare.png)")
     cmp_.add_argument("--mapping", type=InputPath, help="column-mapping file for MEASURED")
+    add_params_arguments(cmp_, without=False)  # the rig MEASURED comes from: its units checked
     cmp_.set_defaults(func=cmd_compare)
 
     diag = sub.add_parser("diagnose", help="why model and rig disagree: cause, extension, gain")
@@ -156,6 +157,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
     check_outputs(folders=[args.report])
     campaign = read_campaign(args.campaign, mapping_of(args))
+    for problem in campaign.problems:
+        progress(f"skipped: {problem}")
     params = params_of(args)
     progress(f"simulating {len(campaign.runs)} runs with their measured inputs")
     validation = validate_campaign(campaign.runs, params)
@@ -166,6 +169,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
+    from landing_gear_sim.calibration.plausibility import check_units
+    from landing_gear_sim.calibration.runs import classify_all
     from landing_gear_sim.calibration.validate import compare
     from landing_gear_sim.report.figures import DISPLAY_UNITS
     from landing_gear_sim.report.pages import text_table
@@ -173,7 +178,10 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
     check_outputs(files=[args.plot])
     measured, simulated = read_one(args.measured, mapping_of(args)), read_one(args.simulated)
+    check_units(classify_all([measured]), params_of(args))  # before a fit % of −600,000
     comparison = compare(measured, simulated)
+    for note in comparison.notes:
+        progress(f"note: {note}")
     rows = []
     for channel, score in comparison.scores.items():
         factor, unit = DISPLAY_UNITS[channel]  # as the plot shows it (issue 32: Pa and N)

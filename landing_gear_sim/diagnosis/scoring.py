@@ -85,8 +85,9 @@ def split_runs(candidate: Candidate, runs: Sequence[Run]
     """Runs to fit the candidate on, and runs kept to check it.
 
     Actuator effects are checked on the braking runs' pressure. Otherwise the runs
-    of each class are sorted by length and alternate between the two sets (the
-    shorter to fitting), so both see every kind of test; with none to spare, an actuator
+    of each class alternate between the two sets, the one that slides furthest first and
+    to fitting, the rest by length (the shorter to fitting), so both see every kind of test
+    and no held-out run slides beyond what was fitted; with none to spare, an actuator
     run's later part is held out in time (:func:`_held_out_in_time`).
     """
     classified = classify_all(runs)
@@ -101,11 +102,43 @@ def split_runs(candidate: Candidate, runs: Sequence[Run]
     for r in own or others:
         by_class.setdefault(r.kind, []).append(r)
     for members in by_class.values():
-        for i, r in enumerate(sorted(members, key=len)):
+        for i, r in enumerate(_widest_first(members)):
             (fit if i % 2 == 0 else held).append(r)
     if not held:
         return _held_out_in_time(fit)
     return fit, held
+
+
+def _widest_first(members: list[ClassifiedRun]) -> list[ClassifiedRun]:
+    """The runs of one class, the braking run that slides furthest first, the rest by
+    length. A held-out run sliding beyond every fitted one tests an extrapolation no
+    friction law passes (U01: a magic-formula tyre fitted on stops below 0.15 slip and
+    checked on one sliding to 0.6: every curve, the plain one too, went wild there)."""
+    by_length = sorted(members, key=len)
+    if not by_length[0].braking:
+        return by_length
+    widest = max(by_length, key=slip_reach)
+    return [widest, *(r for r in by_length if r is not widest)]
+
+
+SLIP_REACH_PERCENTILE = 99.0  # of a stop's braked samples: a lock shows, a count's step not
+TURNING = 0.2  # of the flywheel's top speed: below it the speeds' ratio is noise
+
+
+def slip_reach(run: ClassifiedRun) -> float:
+    """How far the wheel slides behind the flywheel while braking: the wheel's speed over
+    the flywheel's, as a fraction below its free-rolling value (the radii cancel: no
+    parameter needed to rank a class's stops)."""
+    flywheel = run.flywheel_speed_rad_s
+    turning = flywheel > TURNING * max(float(flywheel.max()), 1e-9)
+    ratio = run.wheel_speed_rad_s[turning] / flywheel[turning]
+    braked = run.time_s[turning] >= run.brake_start_s
+    if braked.all() or not braked.any():
+        return 0.0
+    free = float(np.percentile(ratio[~braked], 90.0))  # spun up, not before touchdown
+    if free <= 0.0:
+        return 0.0
+    return float(np.percentile(1.0 - ratio[braked] / free, SLIP_REACH_PERCENTILE))
 
 
 SETTLED_SPLIT_S = 0.5  # a run cut in time is cut where the current has held this long

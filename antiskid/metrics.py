@@ -75,7 +75,10 @@ def stops(run: Run) -> list[Run]:
     itself; a day's log of many is its stops (one hour of 227 stops was measured as one of
     3598 s)."""
     on = np.flatnonzero(run.current_a > BRAKE_ON_CURRENT_A)
-    ends = on[np.flatnonzero(np.diff(run.time_s[on]) > STOP_GAP_S)] if on.size else on
+    # a brake released between them: samples logged off (a log's gap while braking is
+    # none: it had split a stop in two)
+    apart = (np.diff(run.time_s[on]) > STOP_GAP_S) & (np.diff(on) > 1)
+    ends = on[np.flatnonzero(apart)] if on.size else on
     if ends.size == 0:
         return [run]
     bounds = [0, *(int(e) + 1 for e in ends), len(run)]
@@ -126,6 +129,21 @@ def braking_metrics(run: Run, rig: RigParameters) -> BrakingMetrics:
         gear_walk_frequency_hz=gear_walk,
         cycling_near_gear_walk=cycles > 0 and abs(cycles - gear_walk) <= GEAR_WALK_BAND * gear_walk,
     )
+
+
+UNFINISHED_SHARE = 0.25  # a log ending above this share of the braking speed cut its stop
+
+
+def unfinished(run: Run, rig: RigParameters) -> str | None:
+    """What a stop whose log ends before the stop does is (None: it ended): above a quarter
+    of the speed it braked from and twice the rig's stop speed (a stop cut at half its
+    speed had been reported as a stop of 236 m in 4.9 s)."""
+    vehicle, _ = speeds_m_s(run, rig)
+    start, end = float(vehicle[braking_window(run)][0]), float(vehicle[-1])
+    if end <= max(UNFINISHED_SHARE * start, 2.0 * rig.number(K.RIG_TEST_STOP_SPEED_M_S)):
+        return None
+    return (f"{run.name}: the log ends at {end:.3g} m/s, braking from {start:.3g} m/s: the "
+            "stop never ended; its distance, time and deceleration are of the part logged")
 
 
 def _efficiency(rig: RigParameters, friction: np.ndarray, speed_m_s: np.ndarray,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -15,7 +16,7 @@ from .csv_io import read_csv, read_named, run_name
 from .errors import RunFormatError
 from .mapping import Mapping
 from .run import SIGNALS, Run
-from .timebase import split_at_gaps
+from .timebase import split_at_gaps, time_base_notes
 from .workbook import SUFFIXES as WORKBOOK_SUFFIXES
 from .workbook import read_workbook
 
@@ -60,8 +61,15 @@ def _kind(path: Path) -> str:
 
 
 def read_run(path: Path, mapping: Mapping | None = None, name: str | None = None) -> Run:
-    """A run from a bag, a delimited text file or a binary table (see ``README`` formats)."""
-    path = Path(path)
+    """A run from a bag, a delimited text file or a binary table (see ``README`` formats),
+    with what its time base costs in its notes (:func:`~msg_tools.timebase.time_base_notes`:
+    judged here, once, for every command)."""
+    run = _read_any(Path(path), mapping, name)
+    judged = time_base_notes(run)
+    return dataclasses.replace(run, notes=(*run.notes, *judged)) if judged else run
+
+
+def _read_any(path: Path, mapping: Mapping | None, name: str | None) -> Run:
     if not path.exists():
         raise RunFormatError(f"{path}: no such file or folder")
     kind = _kind(path)

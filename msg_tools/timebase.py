@@ -141,3 +141,37 @@ def _unusable(part: Run) -> str:
             and np.median(part.pressure_pa[head]) > BRAKING_PRESSURE_PA):
         return "it begins mid-stop, with the brake acting on the loaded wheel"
     return ""
+
+
+RATE_CHANGE = 0.1  # a log's two ends sampled this far apart (relative) changed its rate
+
+
+def time_base_notes(run: Run) -> tuple[str, ...]:
+    """What a run's time base will cost, in words: a gap too long to bridge while the brake
+    acts on the loaded wheel (no stop is measured across it: a campaign reader splits the
+    run there and leaves the part begun mid-stop out), and a rate that changes within the
+    run (it is resampled at its mean rate for the model)."""
+    notes = [note] if (note := _rate_change(run)) else []
+    clock = fixed_rate_clock(run.time_s)
+    if clock is not None:
+        braking = (run.pressure_pa > BRAKING_PRESSURE_PA) & (run.vertical_load_n > CONTACT_LOAD_N)
+        notes.extend(f"{run.name}: {gap_text(run.time_s, clock, int(k))} while braking: no "
+                     "stop is measured across it (a campaign splits the run there and leaves "
+                     "the part begun mid-stop out)"
+                     for k in np.flatnonzero(clock.missing > bridgeable(clock))
+                     if braking[k - 1] and braking[k])
+    return tuple(notes)
+
+
+def _rate_change(run: Run) -> str | None:
+    """A rate at the run's start unlike the one at its end, in words (None: one rate). On
+    its fast clock the slow part's samples read as one-sample gaps, interpolated."""
+    quarter = max(2, run.time_s.size // 4)
+    first, last = (1.0 / float(np.median(np.diff(part)))
+                   for part in (run.time_s[:quarter], run.time_s[-quarter:]))
+    if abs(last / first - 1.0) <= RATE_CHANGE:
+        return None
+    return (f"{run.name}: sampled at {first:.4g} Hz at its start and {last:.4g} Hz at its "
+            f"end: the slower part is interpolated onto the faster part's clock or both "
+            "are resampled at the mean rate for the model; its noise and detail differ "
+            "from the rest")

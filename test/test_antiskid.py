@@ -178,3 +178,40 @@ def test_metrics_of_a_log_of_several_stops_are_given_per_stop(tmp_path, capsys, 
     for stop, run in zip(written["stops"], alone, strict=True):
         assert stop["stopping_time_s"] == pytest.approx(
             braking_metrics(run, reference).stopping_time_s, abs=0.01)
+
+
+def test_a_gap_in_the_log_during_a_stop_is_refused_not_taken_for_two_stops(tmp_path, capsys,
+                                                                          reference):
+    """Issue 43: a 2 s gap during braking gave two 'stops' and no note; the same gap in free
+    rolling is refused, and so is this one now, saying it fell while braking."""
+    import dataclasses
+
+    from msg_tools.csv_io import write_csv
+    from msg_tools.run import SIGNALS
+
+    run = simulate(reference, sc.constant_pressure_test(reference, 30e5)).to_run(3)
+    on = np.flatnonzero(run.current_a > 0.5 * run.current_a.max())
+    lost = slice(on[len(on) // 3], on[len(on) // 3] + round(2.0 * run.rate_hz))
+    keep = np.r_[0:lost.start, lost.stop:len(run)]
+    write_csv(dataclasses.replace(run, time_s=run.time_s[keep],
+                                  **{s: getattr(run, s)[keep] for s in SIGNALS}),
+              tmp_path / "gap.csv")
+    assert main(["metrics", str(tmp_path / "gap.csv")]) == 2
+    out = capsys.readouterr()
+    assert "stop 2" not in out.out and "Traceback" not in out.err
+    assert "2 s missing" in out.err and "while braking" in out.err
+
+
+def test_a_stop_the_log_cuts_short_is_said_not_measured_as_a_stop(tmp_path, capsys, reference):
+    """Issue 43: a stop cut at half its speed was reported as a stop (236 m, 4.9 s)."""
+    from msg_tools.csv_io import write_csv
+
+    run = simulate(reference, sc.constant_pressure_test(reference, 30e5)).to_run(3)
+    speed = run.flywheel_speed_rad_s
+    half = int(np.flatnonzero(speed < 0.5 * speed.max())[0])
+    write_csv(run.part(slice(0, half), "cut"), tmp_path / "cut.csv")
+    write_csv(run, tmp_path / "whole.csv")
+    assert main(["metrics", str(tmp_path / "cut.csv")]) == 0
+    assert "never ended" in capsys.readouterr().err
+    assert main(["metrics", str(tmp_path / "whole.csv")]) == 0
+    assert "never ended" not in capsys.readouterr().err

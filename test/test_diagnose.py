@@ -23,7 +23,7 @@ from landing_gear_sim.diagnosis.diagnose import Diagnosis, diagnose
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.scoring import split_runs
 from landing_gear_sim.errors import DiagnosisError
-from landing_gear_sim.report.diagnosis import headline, parameter_text
+from landing_gear_sim.report.words import headline, parameter_text
 from msg_tools.csv_io import read_csv, write_csv
 from msg_tools.io import read_campaign
 
@@ -222,8 +222,9 @@ def test_cli_writes_the_contract_json_and_the_report(reference, tmp_path, capsys
     assert "calibrated model" in page and "extended model" in page
     out = capsys.readouterr().out
     assert "VERDICT: actuator_delay" in out
-    headline = re.search(r"actuator_delay: delay = (\d\.\d+) ± [\d.]+ ms; on runs it was "
-                         r"not fitted on, the extended model is better by \d+", out)
+    headline = re.search(r"actuator_delay: the valve answers later than the model's, delay = "
+                         r"(\d\.\d+) ± [\d.]+ ms; on the runs it was not fitted on the brake "
+                         r"pressure fits [\d.]+ → [\d.]+ % \(RMSE [\d.]+ → [\d.]+ bar\)", out)
     assert headline and abs(float(headline[1]) - 6.0) < 0.3, out
     assert html.escape(headline[0]) in page
     assert main(["params", "--config", str(tmp_path / "extended.yaml")]) == 0
@@ -254,10 +255,34 @@ def test_the_one_sentence_verdict_names_both_of_two_effects(reference):
         finding("pressure_sensor_offset", "offset_pa", 99590.0, 390.0, -10447.5)],
         candidates=[], baseline={}, start=reference, calibrated=reference, extended=reference,
         signatures_before=[], signatures_after=[])
+    # issue 42: in the engineer's words, the gain as fit % (was '1494 log-likelihood units')
     assert headline(result) == (
-        "actuator_delay: delay = 12 ± 0.29 ms; on runs it was not fitted on, the extended "
-        "model is better by 1494 log-likelihood units (pressure 95.5 → 96.4 %). Also "
-        "pressure_sensor_offset: offset = 0.9959 ± 0.0039 bar.")
+        "actuator_delay: the valve answers later than the model's, delay = 12 ± 0.29 ms; on "
+        "the runs it was not fitted on the brake pressure fits 95.5 → 96.4 %. Also "
+        "pressure_sensor_offset: the pressure transducer reads off its zero, offset = 0.9959 "
+        "± 0.0039 bar.")
+
+
+def test_a_discovered_term_is_said_as_its_equations_law(reference):
+    found = Finding(cause="discovered", parameters={"μ_B²": 0.489}, std={"μ_B²": 0.0034},
+                    evidence="", fit_before={"wheel_speed_rad_s": 98.43,
+                                             "flywheel_speed_rad_s": 99.41},
+                    fit_after={"wheel_speed_rad_s": 98.68, "flywheel_speed_rad_s": 99.41},
+                    delta_bic=-117.0, held_out=-2078.0,
+                    accepted=True, family="tyre", term="μ = μ_B(λ)·g(F_z) + 0.489·μ_B²")
+    result = Diagnosis(verdict="discovered", findings=[found], candidates=[], baseline={},
+                       start=reference, calibrated=reference, extended=reference,
+                       signatures_before=[], signatures_after=[])
+    assert headline(result) == (
+        "discovered tyre: the tyre's law lacks a term the runs show, μ = μ_B(λ)·g(F_z) + "
+        "0.489·μ_B² (μ_B² = 0.489 ± 0.0034); on the runs it was not fitted on the wheel speed "
+        "fits 98.4 → 98.7 %.")
+    # issue 42: the gain in the channel's own unit too
+    measured = dataclasses.replace(found, rmse_before={"wheel_speed_rad_s": 1.234},
+                                   rmse_after={"wheel_speed_rad_s": 0.98})
+    assert "fits 98.4 → 98.7 % (RMSE 1.23 → 0.98 rad/s)" in headline(
+        dataclasses.replace(result, findings=[measured]))
+    assert measured.to_json()["rmse_after"] == {"wheel_speed_rad_s": 0.98}
 
 
 def test_cli_diagnose_on_a_missing_folder_is_one_error_line(capsys):

@@ -62,3 +62,88 @@ def test_the_consistency_chart_colours_only_what_the_verdict_calls_violated(tmp_
     for check in (under_floor, violated, within_sigma):
         assert (reach(check) > 1.0) == check.violated
         assert (_colour(check) == "tab:red") == check.violated
+
+
+def test_the_first_screen_draws_where_the_starting_model_misses_the_verdicts_channel(
+        reference, tmp_path):
+    """Issue 42: the page was tables; the engineer asks where the model misses, and by how
+    much, before and after. The figure opens the page, on the channel the finding helps and
+    the run and moment the starting model misses most."""
+    import dataclasses
+
+    import numpy as np
+
+    from landing_gear_sim.calibration.runs import classified
+    from landing_gear_sim.diagnosis.diagnose import Diagnosis
+    from landing_gear_sim.diagnosis.findings import Finding
+    from landing_gear_sim.diagnosis.signatures import RunEvidence
+    from landing_gear_sim.model import scenario as sc
+    from landing_gear_sim.model.integrate import simulate
+    from landing_gear_sim.report.diagnosis import write_diagnosis_report
+    from landing_gear_sim.report.first_screen import worst_misfit
+
+    def evidence(bar: float, bump_at_s: float, size: float) -> RunEvidence:
+        run = simulate(reference, sc.constant_pressure_test(reference, bar * 1e5)).to_run(1)
+        t = run.time_s - run.time_s[0]
+        missed = dataclasses.replace(run, wheel_speed_rad_s=run.wheel_speed_rad_s
+                                     + size * np.exp(-((t - bump_at_s) / 0.1) ** 2))
+        return RunEvidence(classified(dataclasses.replace(missed, name=f"stop_{bar:g}bar")),
+                           run, missed, "wheel_speed_rad_s", None)
+
+    found = Finding(cause="discovered", parameters={}, std={}, evidence="",
+                    fit_before={"wheel_speed_rad_s": 90.0, "pressure_pa": 99.0},
+                    fit_after={"wheel_speed_rad_s": 95.0, "pressure_pa": 99.0},
+                    delta_bic=-50.0, held_out=-80.0, accepted=True, family="wheel",
+                    term="J_w·ω̇ = r·F_x − T_b − 148 N m")
+    result = Diagnosis(verdict="discovered", findings=[found], candidates=[], baseline={},
+                       start=reference, calibrated=reference, extended=reference,
+                       signatures_before=[], signatures_after=[],
+                       evidence=[evidence(20, 3.0, 2.0), evidence(30, 4.0, 6.0)])
+    misfit = worst_misfit(result)
+    run = misfit.evidence.run
+    shown = run.time_s[misfit.window] - run.time_s[0]
+    assert misfit.channel == "wheel_speed_rad_s" and run.name == "stop_30bar"
+    assert shown[0] < 4.0 < shown[-1] and shown[-1] - shown[0] < 0.5 * (run.time_s[-1]
+                                                                         - run.time_s[0])
+    page = write_diagnosis_report(result, tmp_path).read_text()
+    verdict = page[page.index("<h2>Verdict"):page.index("Starting model")]
+    assert "where_it_misses.png" in verdict and (tmp_path / "where_it_misses.png").exists()
+
+
+def _figures_saved(monkeypatch, *modules):
+    """The figures ``modules`` save, kept open for the test to read."""
+    saved = []
+
+    def keep(fig, path):
+        saved.append(fig)
+        return path
+
+    for module in modules:
+        monkeypatch.setattr(module, "save_figure", keep)
+    return saved
+
+
+def _legends_off_the_axes(fig) -> bool:
+    return bool(fig.legends) and all(axis.get_legend() is None for axis in fig.axes)
+
+
+def test_figures_name_their_run_and_keep_their_legends_off_the_traces(reference, tmp_path,
+                                                                       monkeypatch):
+    """Issue 42: legends over the 45–50 bar pressure trace (simulate) and over
+    brake_osc_low's pressure; validation and compare figures without a title naming the
+    run; a PSD of a speed labelled rad/s²/Hz."""
+    from landing_gear_sim.calibration.validate import compare
+    from landing_gear_sim.model import scenario as sc
+    from landing_gear_sim.model.integrate import simulate
+    from landing_gear_sim.report import diagnosis, figures, validation
+
+    result = simulate(reference, sc.constant_pressure_test(reference, 45e5))
+    run = result.to_run(1)
+    saved = _figures_saved(monkeypatch, figures, validation, diagnosis)
+    figures.plot_simulation(result, tmp_path / "s.png")
+    validation.plot_overlay(compare(run, run), tmp_path / "c.png")
+    diagnosis.plot_before_after(run, run, run, ("pressure_pa", "wheel_speed_rad_s"),
+                                tmp_path / "b.png")
+    assert len(saved) == 3 and all(_legends_off_the_axes(fig) for fig in saved)
+    assert all(run.name in fig.get_suptitle() for fig in saved[1:])
+    assert diagnosis.psd_unit("rad/s") == "(rad/s)²/Hz" and diagnosis.psd_unit("Pa") == "Pa²/Hz"

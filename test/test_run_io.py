@@ -18,7 +18,7 @@ from msg_tools.bag_io import write_bag
 from msg_tools.csv_io import format_csv, read_csv, read_mapping, write_csv
 from msg_tools.errors import RunFormatError
 from msg_tools.io import read_campaign, read_run, resample
-from msg_tools.run import Run
+from msg_tools.run import SIGNALS, Run
 from msg_tools.units import RPM_RAD_S
 
 MAPPING = """
@@ -422,3 +422,17 @@ def test_validate_says_which_files_of_a_campaign_it_skipped(tmp_path, csv_file, 
     assert main(["validate", str(folder), "--report", str(tmp_path / "report")]) == 0
     err = capsys.readouterr().err
     assert "skipped" in err and "brake_const_20bar.csv" in err
+
+
+def test_a_log_that_changes_its_rate_says_so_when_read(tmp_path, csv_file):
+    """Issue 43: a log switching from 1 kHz to 500 Hz was resampled at its mean rate with no
+    note (slip rms +15 %)."""
+    run = read_csv(csv_file)
+    half = len(run) // 2
+    keep = np.r_[0:half, half:len(run):2]
+    write_csv(dataclasses.replace(run, time_s=run.time_s[keep],
+                                  **{s: getattr(run, s)[keep] for s in SIGNALS}),
+              tmp_path / "switched.csv")
+    notes = read_run(tmp_path / "switched.csv").notes
+    assert any("1000 Hz at its start and 500 Hz at its end" in n for n in notes), notes
+    assert not read_run(csv_file).notes

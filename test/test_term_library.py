@@ -285,6 +285,18 @@ def test_a_load_cell_that_drifts_is_discovered_in_the_f_x_channel_not_the_wheel(
     assert finding.term.startswith("F_x,read = F_x")
 
 
+def test_a_load_cells_zero_drifting_with_the_load_it_carries_is_found_in_the_f_x_channel(
+        reference, tmp_path):
+    """Issue 41's own sweep: F_x-channel laws outside the library (√t·F_z) were 0/4, named a
+    wheel term or left unexplained (off the ground F_z is 0, in the free rolling t is short);
+    the flywheel's momentum balance shows the reading's excess while braking."""
+    size = float(np.random.default_rng(415).uniform(1e-3, 3e-3))
+    law = basis.product_code(basis.factor_code(basis.RUN_TIME, basis.SIGNED_ROOT),
+                             basis.factor_code(basis.LOAD, basis.IDENTITY))
+    result = _diagnosed(reference, tmp_path, 415, Slot.FX_CHANNEL, [(law, size)])
+    assert _first(result, "F_x channel").term.startswith("F_x,read = F_x")
+
+
 def test_the_diagnosis_contract_lists_each_generic_slots_library_as_composed():
     """docs/diagnosis.md's table of the generic slots' libraries: one row per equation with
     a generic slot, naming every signal its library composes and the slot's keys."""
@@ -304,3 +316,15 @@ def test_the_diagnosis_contract_lists_each_generic_slots_library_as_composed():
         assert library.slot is not None
         code_key = library.slot.keys[0][0]
         assert f"`{code_key.replace('_1_code', '_<k>_*')}`" in page, code_key
+
+
+def test_a_term_the_samples_never_fill_is_left_out_not_a_nan():
+    """The F_x channel's owned flywheel terms are 0 in a campaign without a stop: the lasso
+    had divided by their zero spread (actuator runs alone: 'Input X contains NaN')."""
+    from landing_gear_sim.diagnosis.sparse import sparse_coefficients
+
+    x = np.column_stack([np.linspace(0.0, 1.0, 50), np.zeros(50)])
+    for intercept in (True, False):
+        coefficients = sparse_coefficients(x, 3.0 * x[:, 0], intercept=intercept)
+        assert np.all(np.isfinite(coefficients)) and coefficients[1] == 0.0
+        assert coefficients[0] == pytest.approx(3.0, rel=0.05)

@@ -235,7 +235,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
 
 
 def cmd_metrics(args: argparse.Namespace) -> int:
-    from antiskid.metrics import braking_metrics, stops
+    from antiskid.metrics import braking_metrics, stops, unfinished
     from landing_gear_sim.calibration.plausibility import check_units
     from landing_gear_sim.calibration.runs import classify_all
     from landing_gear_sim.report.braking import metrics_table
@@ -247,6 +247,8 @@ def cmd_metrics(args: argparse.Namespace) -> int:
     # a unit within every range (a wheel in rpm: slip −7.8 accepted) named as identify does
     check_units(classify_all(parts), rig)
     rows = {part.name: braking_metrics(part, rig) for part in parts}
+    for note in filter(None, (unfinished(part, rig) for part in parts)):
+        progress(f"note: {note}")
     print(metrics_table(rows))
     if len(parts) == 1:
         _write_braking_outputs(args, run, rig, rows[run.name])

@@ -236,9 +236,13 @@ KNOWN_RATE_HZ = 100.0  # samples where F_x is known, thinned to this
 
 class FxChannelLibrary(Library[tuple[ClassifiedRun, "br.Braking | None"]]):
     """The load cell's F_x channel, F_x,read = F_x + c F_z + Σ c_k φ_k(F_z, t): its error is
-    the reading less the true F_x where that is known — off the ground (0) and in the free
+    the reading less the true F_x where that is known — off the ground (0), in the free
     rolling before the brake acts (the wheel's inertia force and the model's wheel torque,
-    pushed by the tyre)."""
+    pushed by the tyre) and, while braking, the flywheel's: its momentum balance over
+    windows of BALANCE_WINDOW_S gives the force's mean there (a drift or a bend that grows
+    with the load shows under the load: off the ground F_z is 0, in the free rolling t is
+    short; such terms had been named a wheel term or left unexplained). The flywheel's mass
+    and drag are owned: a calibration's small error in them is not a channel's."""
 
     equation = Equation.FX_CHANNEL
     relation = Relation.FX_CHANNEL
@@ -257,6 +261,7 @@ class FxChannelLibrary(Library[tuple[ClassifiedRun, "br.Braking | None"]]):
              terms: Sequence[Term[tuple[ClassifiedRun, br.Braking | None]]] | None = None
              ) -> Rows | None:
         run, b = source
+        chosen = terms or self.terms
         time = br.run_time_s(run)
         if b is not None:
             mask, excess = br.free_rolling_excess(b, params)
@@ -267,18 +272,58 @@ class FxChannelLibrary(Library[tuple[ClassifiedRun, "br.Braking | None"]]):
                 run.longitudinal_force_n, run.vertical_load_n, time))
         step = max(1, round(run.rate_hz / KNOWN_RATE_HZ))
         index, error = index[::step], error[::step]
-        if index.size < 20:
+        columns = term_columns(chosen, source, params, index, _fx_signals(run, time, index))
+        owned = np.zeros((index.size, 2))
+        if b is not None and (windows := _balance_windows(b, params, chosen, source)):
+            error, columns, owned = (np.concatenate([a, w]) for a, w in zip(
+                (error, columns, owned), windows, strict=True))
+        if error.size < 20:
             return None
-        measured = np.zeros((index.size, basis.N_SIGNALS))
-        measured[:, basis.LOAD] = run.vertical_load_n[index]
-        measured[:, basis.RUN_TIME] = time[index]
-        return Rows(error, term_columns(terms or self.terms, source, params, index, measured),
-                    np.zeros((index.size, 0)), params.number(K.LOADING_STATIC_LOAD_N))
+        return Rows(error, columns, owned, params.number(K.LOADING_STATIC_LOAD_N))
 
     def law(self, written: str, params: RigParameters) -> str:
         crosstalk = params.number(K.SENSORS_CROSSTALK_FX_PER_FZ)
         shown = f" {signed(crosstalk, spec='.4g')}·F_z" if crosstalk else ""
         return f"F_x,read = F_x{shown} {written}"
+
+
+BALANCE_WINDOW_S = 1.0  # the flywheel's speed noise over m_f·Δv falls with the window
+
+
+def _fx_signals(run: ClassifiedRun, time: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """The F_x channel slot's signals at the samples ``index``: the load and the run's time."""
+    measured = np.zeros((index.size, basis.N_SIGNALS))
+    measured[:, basis.LOAD] = run.vertical_load_n[index]
+    measured[:, basis.RUN_TIME] = time[index]
+    return measured
+
+
+def _balance_windows(b: br.Braking, params: RigParameters, terms: Sequence[Term[Any]],
+                     source: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The F_x reading's mean excess over the flywheel's momentum balance in windows of a
+    stop (m_f Δv + ∫(F_x + α_d v² + F_f) dt over the window's length), the terms' means
+    there, and the owned columns (the mass's Δv and the drag's v², same means); None: no
+    window. Windows start KNOWN_RATE_HZ apart, on the flywheel and above the stop speed."""
+    p = params.vector()
+    width = round(BALANCE_WINDOW_S * b.run.rate_hz)
+    on = np.flatnonzero((b.time_s > b.start_s) & (b.load > br.LOADED_N)
+                        & (b.speed_m_s > 1.0 + params.number(K.RIG_TEST_STOP_SPEED_M_S)))
+    if on.size <= width:
+        return None
+    span = np.arange(on[0], on[-1] + 1)
+    dt = np.diff(b.time_s, prepend=b.time_s[0])[span]
+    speed = b.speed_m_s[span]
+    resisting = b.force[span] + el.drag_forces(p, speed) + el.flywheel_extra_force(p, speed)
+    time = br.run_time_s(b.run)
+    values = np.column_stack([
+        el.translational_mass(p) * speed + np.cumsum(resisting * dt),
+        np.cumsum(term_columns(terms, source, params, span, _fx_signals(b.run, time, span))
+                  * dt[:, None], axis=0),
+        el.translational_mass(p) * speed, np.cumsum(speed * speed * dt)])
+    starts = np.arange(0, span.size - width, max(1, round(b.run.rate_hz / KNOWN_RATE_HZ)))
+    means = (values[starts + width] - values[starts]) / (b.time_s[span][starts + width]
+                                                         - b.time_s[span][starts])[:, None]
+    return means[:, 0], means[:, 1:1 + len(terms)], -means[:, 1 + len(terms):]
 
 
 def _slip_noise(b: br.Braking, index: np.ndarray) -> np.ndarray:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 
 class SignatureKind(str, enum.Enum):
@@ -58,6 +58,9 @@ class Finding:
     """A scored candidate: why it was accepted or not, by the first rule it met or failed."""
     round: int = 0
     """A scored candidate: the round of the search it was scored in (0: the discovery's)."""
+    rmse_before: dict[str, float] = field(default_factory=dict)
+    rmse_after: dict[str, float] = field(default_factory=dict)
+    """RMSE per channel on the held-out runs [the channel's SI unit], beside the fit %."""
 
     def to_json(self) -> dict[str, object]:
         document: dict[str, object] = {"cause": self.cause, "parameters": self.parameters,
@@ -67,6 +70,8 @@ class Finding:
                     "fitted_on": list(self.fitted_on), "checked_on": list(self.checked_on)}
         if self.reason:
             document |= {"reason": self.reason, "round": self.round}
+        if self.rmse_after:
+            document |= {"rmse_before": self.rmse_before, "rmse_after": self.rmse_after}
         if self.family:
             document |= {"family": self.family, "term": self.term}
         if self.equation:

@@ -69,6 +69,15 @@ def channel_fits(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequen
             for c in channels if spreads[c] > 0}
 
 
+def channel_rmse(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequence[str]
+                 ) -> dict[str, float]:
+    """RMSE per channel of ``simulated`` against ``runs``, pooled [the channel's SI unit]."""
+    return {c: float(np.sqrt(np.mean(np.concatenate(
+        [(getattr(run, c) - getattr(sim, c)) ** 2 for run, sim in zip(runs, simulated,
+                                                                      strict=True)]))))
+            for c in channels}
+
+
 def effective_count(residual: np.ndarray) -> float:
     """Samples worth of independent information: n (1 − ρ₁)/(1 + ρ₁) (AR(1) residual)."""
     rho = float(np.clip(lag_one_correlation(residual), 0.0, 0.999))
@@ -215,6 +224,7 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
         + (f"; not accepted: {beyond}" if beyond else "")
     finding = Finding(cause=candidate.cause, parameters=parameters, std=std, evidence=evidence,
                       fit_before=held.before, fit_after=held.after,
+                      rmse_before=held.rmse_before, rmse_after=held.rmse_after,
                       delta_bic=round(delta_bic, 1),
                       held_out=None if held.delta is None else round(held.delta, 1),
                       accepted=accepted, fitted_on=_names(fit_runs),
@@ -258,6 +268,8 @@ class HeldOut:
     after: dict[str, float] = field(default_factory=dict)
     gain: float = 0.0
     denoised: tuple[str, float, float] | None = None
+    rmse_before: dict[str, float] = field(default_factory=dict)
+    rmse_after: dict[str, float] = field(default_factory=dict)
 
 
 def _held_out(candidate: Candidate, runs: Sequence[Run], with_it: CandidateFit,
@@ -269,16 +281,18 @@ def _held_out(candidate: Candidate, runs: Sequence[Run], with_it: CandidateFit,
     delta = log_ratio(scaled_error(runs, sim_with, channels, scales),
                       scaled_error(runs, sim_without, channels, scales))
     before, after = (channel_fits(runs, sim, channels) for sim in (sim_without, sim_with))
+    rmse_before, rmse_after = (channel_rmse(runs, sim, [*after])
+                               for sim in (sim_without, sim_with))
     logged = max((after[c] - before[c] for c in after), default=0.0)
     if logged >= MIN_GAIN_POINTS:
-        return HeldOut(delta, before, after, logged)
+        return HeldOut(delta, before, after, logged, None, rmse_before, rmse_after)
     clean_before, clean_after = (channel_fits(runs, sim, channels, DENOISED_HZ)
                                  for sim in (sim_without, sim_with))
     best = max(clean_after, key=lambda c: clean_after[c] - clean_before[c], default=None)
     if best is None or clean_after[best] - clean_before[best] <= logged:
-        return HeldOut(delta, before, after, logged)
+        return HeldOut(delta, before, after, logged, None, rmse_before, rmse_after)
     return HeldOut(delta, before, after, clean_after[best] - clean_before[best],
-                   (best, clean_before[best], clean_after[best]))
+                   (best, clean_before[best], clean_after[best]), rmse_before, rmse_after)
 
 
 def _from_null(candidate: Candidate, runs: Sequence[ClassifiedRun], null: CandidateFit,

@@ -12,10 +12,12 @@ def sparse_coefficients(x: np.ndarray, y: np.ndarray, intercept: bool = True) ->
     # imported here: scikit-learn costs ~1 s to import, which only a diagnosis needs to pay
     from sklearn.linear_model import LassoLarsIC
 
+    spread = x.std(axis=0) if intercept else np.sqrt(np.mean(x * x, axis=0))
+    # a column the samples never fill (an owned term of rows a campaign lacks: the flywheel's
+    # balance with no stop in it) is a term left out, not a NaN
+    spread = np.where(spread > 0.0, spread, 1.0)
     if intercept:
-        spread = x.std(axis=0)
         fit = LassoLarsIC(criterion="bic").fit((x - x.mean(axis=0)) / spread, y)
     else:
-        spread = np.sqrt(np.mean(x * x, axis=0))
         fit = LassoLarsIC(criterion="bic", fit_intercept=False).fit(x / spread, y)
     return np.asarray(fit.coef_) / spread

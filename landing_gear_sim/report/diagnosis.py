@@ -20,15 +20,16 @@ import numpy as np
 
 from landing_gear_sim.calibration.measured import CHANNELS
 from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
-from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.relations import Z_VIOLATED, Check, Relation
 from landing_gear_sim.diagnosis.residuals import Spectrum
 from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, HELD_OUT_THRESHOLD
 from landing_gear_sim.model.datasheet import UNITS, datasheet_values
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.report.figures import DISPLAY_UNITS, save_figure
+from landing_gear_sim.report.first_screen import first_figure
 from landing_gear_sim.report.local import local_gain_section
 from landing_gear_sim.report.pages import html_image, html_table, text_table, write_html
+from landing_gear_sim.report.words import headline, parameters_text, verdict_text
 from msg_tools.run import Run
 from msg_tools.units import display
 
@@ -38,7 +39,7 @@ def plot_before_after(measured: Run, before: Run, after: Run, channels: Sequence
     """Measured (black), starting model (blue) and extended model (red), and the two
     residuals, per channel."""
     fig, axes = plt.subplots(2 * len(channels), 1, figsize=(9, 3.2 * len(channels) + 0.6),
-                             sharex=True, squeeze=False)
+                             sharex=True, squeeze=False, layout="constrained")
     t = measured.time_s - measured.time_s[0]
     for i, channel in enumerate(channels):
         factor, unit = DISPLAY_UNITS[channel]
@@ -54,10 +55,10 @@ def plot_before_after(measured: Run, before: Run, after: Run, channels: Sequence
         bottom.set_ylabel(f"residual\n[{unit}]")
         for axis in (top, bottom):
             axis.grid(alpha=0.3)
-    axes[0, 0].legend(loc="upper right", fontsize=8)
-    axes[-1, 0].set_xlabel("time [s]")
-    fig.suptitle(measured.name)
-    fig.tight_layout()
+    fig.legend(*axes[0, 0].get_legend_handles_labels(), loc="outside lower center", ncols=3,
+               fontsize=8)  # off the traces (it had covered brake_osc_low's pressure)
+    axes[-1, 0].set_xlabel(f"time in {measured.name} [s]")
+    fig.suptitle(f"{measured.name}: measured, starting and extended model")
     return save_figure(fig, path)
 
 
@@ -77,7 +78,7 @@ def plot_spectrum(spectrum: Spectrum, title: str, unit: str, path: Path) -> Path
         axis.annotate(f"{peak.frequency_hz:.2f} Hz", (f[i], spectrum.psd[i]), fontsize=8,
                       xytext=(4, 6), textcoords="offset points", color="r")
     axis.set_xlabel("frequency [Hz]")
-    axis.set_ylabel(f"PSD [{unit}²/Hz]")
+    axis.set_ylabel(f"PSD [{psd_unit(unit)}]")
     axis.set_title(title, fontsize=10)
     axis.grid(alpha=0.3, which="both")
     axis.legend(fontsize=8)
@@ -85,74 +86,16 @@ def plot_spectrum(spectrum: Spectrum, title: str, unit: str, path: Path) -> Path
     return save_figure(fig, path)
 
 
+def psd_unit(unit: str) -> str:
+    """The unit of a PSD of a signal in ``unit``: (rad/s)²/Hz, Pa²/Hz (it had read
+    'rad/s²/Hz', an acceleration's)."""
+    return f"({unit})²/Hz" if "/" in unit or " " in unit else f"{unit}²/Hz"
+
+
 def write_diagnosis_report(result: Diagnosis, folder: Path) -> Path:
     """The diagnosis page ``folder/index.html`` with its figures; returns the page."""
     sections = diagnosis_sections(result, folder)
     return write_html(folder / "index.html", f"Diagnosis: {verdict_text(result)}", sections)
-
-
-def verdict_text(result: Diagnosis) -> str:
-    """The verdict with what names it: a discovered term's family, an unexplained finding's
-    equation."""
-    best = result.findings[0] if result.findings else None
-    if best is not None and best.family and result.verdict == "discovered":
-        return f"{result.verdict} {best.family}"
-    if best is not None and best.equation and result.verdict == "unexplained":
-        return f"{result.verdict}, in the {best.equation}"
-    return result.verdict
-
-
-KEY_UNITS = {"s": "s", "pa": "Pa", "n": "N", "a": "A", "m": "m", "j": "J", "hz": "Hz",
-             "fraction": "1", "run": "run"}
-"""A parameter key's last word -> its SI unit (a key carries its unit, docs/parameters.md;
-``x_per_n``: per newton)."""
-
-
-def parameter_text(key: str, value: float, std: float | None) -> str:
-    """``name = value ± σ`` in the unit a brake engineer reads, e.g. 'delay = 5.99 ± 0.29 ms'
-    for ``actuator_delay.delay_s`` (issue 32: 0.0059941 ± 0.00029 s), 'gain_drift = −3.475 ±
-    0.0014 %/run' for ``gain_drift_per_run``."""
-    name, _, suffix = key.rsplit(".", 1)[-1].rpartition("_")
-    unit = KEY_UNITS.get(suffix)
-    if unit is not None and name.endswith("_per"):
-        name, unit = name.removesuffix("_per"), f"1/{unit}"
-    if unit is None or unit == "1":
-        name = key.rsplit(".", 1)[-1]
-    if unit is None:
-        return f"{name} = {value:.4g}" + ("" if std is None else f" ± {std:.2g}")
-    shown = display(value, unit, ".4g")
-    if std is None:
-        return f"{name} = {shown}"
-    number, _, unit_shown = shown.partition(" ")
-    return f"{name} = {number} ± {display(std, unit, '.2g').partition(' ')[0]} {unit_shown}"
-
-
-def headline(result: Diagnosis) -> str:
-    """The verdict in one sentence: the cause, its parameters in engineering units, and what
-    it gains on the runs it was not fitted on, stated as an improvement."""
-    if not result.findings:
-        return {"none": "The calibrated model explains every run: nothing is missing.",
-                INCONCLUSIVE: "Inconclusive: the runs cannot test every candidate (see the "
-                "notes)."}.get(result.verdict, f"{result.verdict}.")
-    best, *others = result.findings
-    sentence = f"{verdict_text(result)}{_values(best)}"
-    if best.held_out is not None and best.held_out < 0:
-        gain = ", ".join(f"{c.split('_')[0]} {best.fit_before[c]:.1f} → {best.fit_after[c]:.1f} %"
-                         for c in best.fit_after if c in best.fit_before)
-        sentence += (f"; on runs it was not fitted on, the extended model is better by "
-                     f"{-best.held_out:.0f} log-likelihood units" + (f" ({gain})" if gain else ""))
-    also = "; ".join(f"{f.cause}{_values(f)}" for f in others)  # two effects at once: both
-    return sentence + "." + (f" Also {also}." if also else "")
-
-
-def _values(finding: Finding) -> str:
-    values = _parameters(finding)
-    return f": {values}" if values else ""
-
-
-def _parameters(finding: Finding) -> str:
-    return ", ".join(parameter_text(k, v, finding.std.get(k))
-                     for k, v in finding.parameters.items())
 
 
 def _structure_table(result: Diagnosis) -> str:
@@ -177,7 +120,7 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
          "after", "evidence"],
         [[f.cause + (f" ({f.family}): {f.term}" if f.term else "")
           + (f" — in the {f.equation} ({f.channel})" if f.equation else ""),
-          _parameters(f),
+          parameters_text(f),
           _text(f.delta_bic), _text(_gain(f.held_out)), fits(f.fit_before), fits(f.fit_after),
           f.evidence] for f in result.findings])
     candidates = html_table(
@@ -187,7 +130,9 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
           ", ".join(f"{k} = {v:.4g}" for k, v in f.parameters.items()), _text(f.delta_bic),
           _text(_gain(f.held_out)), ", ".join(f.fitted_on), ", ".join(f.checked_on)]
          for f in result.candidates])
-    verdict = (f"<p><b>{html.escape(headline(result))}</b></p><p>Starting model: "
+    figure = first_figure(result, folder)
+    verdict = (f"<p><b>{html.escape(headline(result))}</b></p>"
+               + (html_image(figure, folder) if figure else "") + "<p>Starting model: "
                f"{', '.join(result.start.sources)}{html.escape(_datasheet(result.start))}. "
                "ΔBIC = BIC(with) − BIC(without) on the "
                f"fitting runs (accepted below {BIC_THRESHOLD:g}, and only if the held-out "
@@ -368,13 +313,13 @@ def diagnosis_summary(result: Diagnosis) -> str:
     if result.verdict == INCONCLUSIVE:
         lines.append("  the runs given cannot test every candidate, or none is left to check one "
                      "on: see the notes")
-    for f in result.findings:
-        lines.append(f"  {f.cause}: {_parameters(f)}")
+    # the headline holds each finding's values and law, the first's held-out gain: what
+    # follows is what it does not (the parameters had been printed twice, the evidence thrice)
+    for i, f in enumerate(result.findings):
+        lines.append(f"  {f.cause}" + (f" ({f.family})" if f.family else "") + ":")
         if f.equation:
             lines.append(f"    where: the {f.equation} (seen in {f.channel})")
-        if f.term:
-            lines.append(f"    {f.family}: {f.term}")
-        if f.fit_after and f.fit_after != f.fit_before:
+        if i and f.fit_after and f.fit_after != f.fit_before:
             gain = ", ".join(f"{c} {f.fit_before[c]:.2f} -> {f.fit_after[c]:.2f} %"
                              for c in f.fit_after)
             lines.append(f"    held-out gain: {gain}")

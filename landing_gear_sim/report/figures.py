@@ -33,7 +33,7 @@ def save_figure(fig: plt.Figure, path: Path) -> Path:
 def plot_simulation(result: SimulationResult, path: Path) -> Path:
     """Speeds, slip, pressure and current, forces of one run (paper Figs. 1 and 14 style)."""
     t = result.time_s
-    fig, axes = plt.subplots(4, 1, figsize=(9, 10), sharex=True)
+    fig, axes = plt.subplots(4, 1, figsize=(9, 10), sharex=True, layout="constrained")
     axes[0].plot(t, result.hub_speed_m_s, "k", label="hub speed $v_h$")
     axes[0].plot(t, result.wheel_speed_rad_s * result.rolling_radius_m, "r",
                  label=r"wheel speed $\omega r$")
@@ -52,16 +52,15 @@ def plot_simulation(result: SimulationResult, path: Path) -> Path:
     axes[3].plot(t, result.longitudinal_force_n / 1e3, "c", label="tyre force $F_x$")
     axes[3].set_ylabel("force [kN]")
     axes[3].set_xlabel("time [s]")
-    for axis in (axes[0], axes[3]):
-        axis.legend(loc="upper right")
-    axes[2].legend(*(a + b for a, b in zip(axes[2].get_legend_handles_labels(),
-                                           current_axis.get_legend_handles_labels(),
-                                           strict=True)), loc="upper right")
+    keyed = [axis.get_legend_handles_labels() for axis in (*axes, current_axis)]
+    handles = [h for hs, _ in keyed for h in hs]
+    labels = [label for _, ls in keyed for label in ls]
+    # one legend under the axes: in each axis' corner it had covered the 45-50 bar pressure
+    fig.legend(handles, labels, loc="outside lower center", ncols=3, fontsize=8)
     for axis in axes:
         axis.grid(alpha=0.3)
     fig.suptitle(f"{result.scenario.name}: {result.scenario.description} "
                  f"({result.stop_reason} at {t[-1]:.2f} s)")
-    fig.tight_layout()
     return save_figure(fig, path)
 
 

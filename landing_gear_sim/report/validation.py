@@ -28,7 +28,7 @@ def plot_overlay(comparison: RunComparison, path: Path) -> Path:
     residual shows the difference (issue 32)."""
     channels = list(comparison.scores)
     fig, axes = plt.subplots(2 * len(channels), 1, figsize=(9, 3.0 * len(channels) + 0.8),
-                             sharex=True, squeeze=False,
+                             sharex=True, squeeze=False, layout="constrained",
                              gridspec_kw={"height_ratios": [2, 1] * len(channels)})
     m, s = comparison.measured, comparison.simulated
     n = min(len(m), len(s))
@@ -47,10 +47,10 @@ def plot_overlay(comparison: RunComparison, path: Path) -> Path:
         bottom.set_ylabel(f"residual\n[{unit}]")
         for axis in (top, bottom):
             axis.grid(alpha=0.3)
-    fig.legend(*axes[0, 0].get_legend_handles_labels(), loc="upper center", ncols=2,
+    fig.legend(*axes[0, 0].get_legend_handles_labels(), loc="outside lower center", ncols=2,
                fontsize=8, frameon=False)
-    axes[-1, 0].set_xlabel("time [s]")
-    fig.tight_layout(rect=(0, 0, 1, 0.97))
+    axes[-1, 0].set_xlabel(f"time in {m.name} [s]")
+    fig.suptitle(f"{m.name} ({comparison.kind}): measured and simulated", fontsize=11)
     return save_figure(fig, path)
 
 

@@ -1,0 +1,143 @@
+"""A diagnosis in a brake engineer's words: what each cause is, physically, and the one
+sentence the page and the terminal open with (the log-likelihood figures stay in the
+tables, for whoever checks the rule)."""
+
+from __future__ import annotations
+
+from landing_gear_sim.calibration.measured import CHANNELS
+from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
+from landing_gear_sim.diagnosis.findings import Finding
+from landing_gear_sim.report.figures import DISPLAY_UNITS
+from msg_tools.units import display
+
+CAUSE_WORDS: dict[str, str] = {
+    "actuator_delay": "the valve answers later than the model's",
+    "pressure_sensor_offset": "the pressure transducer reads off its zero",
+    "actuator_dynamics": "the valve follows its current at another speed than the model's",
+    "tire_relaxation": "the tyre builds its force over a rolled length",
+    "gear_walk": "the landing gear walks fore and aft",
+    "brake_fade": "the brake loses torque as it absorbs energy",
+    "drag": "the flywheel's air drag is not the model's",
+    "load_dependent_radius": "the tyre's rolling radius changes with its load",
+    "friction_curve": "the tyre's friction curve is not the model's",
+    "unexplained": "the model misses something it has no law for",
+    "inconsistent": "the measured channels contradict one another",
+}
+"""Each catalogued cause, physically (a cause missing here reads as its name)."""
+
+FAMILY_WORDS: dict[str, str] = {
+    "input_history": "the valve's pressure depends on its past (a hysteresis)",
+    "channel_skew": "a channel's samples are stamped out of time with the others",
+    "wheel_angle": "something turns with the wheel, once per revolution",
+    "channel_crosstalk": "a load cell reads part of another force",
+    "sliding_speed": "the tyre's friction changes with its sliding speed",
+    "run_drift": "the brake changes from run to run (wear)",
+    "load": "the tyre's friction changes with its load",
+}
+"""Each family a ``discovered`` finding may name, physically; an equation's own family
+reads 'the <equation>'s law lacks a term the runs show'."""
+
+
+def cause_words(finding: Finding) -> str:
+    """What ``finding`` is, physically, in a few words."""
+    if finding.cause == "discovered":
+        family = finding.family or ""
+        return FAMILY_WORDS.get(family, f"the {family}'s law lacks a term the runs show")
+    words = CAUSE_WORDS.get(finding.cause, finding.cause.replace("_", " "))
+    return f"{words} in the {finding.equation}" if finding.equation else words
+
+
+def channel_words(channel: str) -> str:
+    """A channel as the page's figures label it ('wheel speed')."""
+    return CHANNELS.get(channel, channel).split(" [")[0]
+
+
+def held_out_words(finding: Finding) -> str:
+    """What ``finding`` gains on the runs it was not fitted on, as fit % per channel ('' when
+    it gains nothing there)."""
+    if finding.held_out is None or finding.held_out >= 0:
+        return ""
+    both = [c for c in finding.fit_after if c in finding.fit_before]
+    # a channel it leaves as it was is not its gain (99.8 → 99.8 % beside 95.0 → 97.5 %)
+    moved = [c for c in both if f"{finding.fit_before[c]:.1f}" != f"{finding.fit_after[c]:.1f}"]
+    gains = [f"{'the ' + channel_words(c) + ' fits' if i == 0 else channel_words(c)} "
+             f"{finding.fit_before[c]:.1f} → {finding.fit_after[c]:.1f} %{_rmse(finding, c)}"
+             for i, c in enumerate(moved or both)]
+    return "on the runs it was not fitted on " + ", ".join(gains) if gains else ""
+
+
+def _rmse(finding: Finding, channel: str) -> str:
+    """' (RMSE 1.23 → 0.98 rad/s)' in the unit the figures show the channel in ('': not
+    measured)."""
+    if channel not in finding.rmse_after or channel not in finding.rmse_before:
+        return ""
+    factor, unit = DISPLAY_UNITS.get(channel, (1.0, ""))
+    before, after = (finding.rmse_before[channel] * factor, finding.rmse_after[channel] * factor)
+    return f" (RMSE {before:.3g} → {after:.3g} {unit})"
+
+
+def parameters_text(finding: Finding) -> str:
+    """``finding``'s parameters, each ``name = value ± σ`` in engineering units."""
+    return ", ".join(parameter_text(k, v, finding.std.get(k))
+                     for k, v in finding.parameters.items())
+
+
+def finding_sentence(finding: Finding, verdict: str, gain: bool = True) -> str:
+    """One finding: its name, what it is physically, its law or values, and (``gain``) its
+    held-out gain."""
+    values = parameters_text(finding)
+    if finding.term:
+        said = f"{cause_words(finding)}, {finding.term}" + (f" ({values})" if values else "")
+    else:
+        said = cause_words(finding) + (f", {values}" if values else "")
+    gained = held_out_words(finding) if gain else ""
+    return f"{verdict}: {said}" + (f"; {gained}" if gained else "")
+
+
+def headline(result: Diagnosis) -> str:
+    """The verdict in one sentence: the cause, physically, its law or parameters in
+    engineering units, and its fit on the runs it was not fitted on; then the others."""
+    if not result.findings:
+        return {"none": "The calibrated model explains every run: nothing is missing.",
+                INCONCLUSIVE: "Inconclusive: the runs cannot test every candidate (see the "
+                "notes)."}.get(result.verdict, f"{result.verdict}.")
+    best, *others = result.findings
+    also = "; ".join(finding_sentence(f, f.cause, gain=False) for f in others)  # both at once
+    return (finding_sentence(best, verdict_text(result)) + "."
+            + (f" Also {also}." if also else ""))
+
+
+def verdict_text(result: Diagnosis) -> str:
+    """The verdict with what names it: a discovered term's family, an unexplained finding's
+    equation."""
+    best = result.findings[0] if result.findings else None
+    if best is not None and best.family and result.verdict == "discovered":
+        return f"{result.verdict} {best.family}"
+    if best is not None and best.equation and result.verdict == "unexplained":
+        return f"{result.verdict}, in the {best.equation}"
+    return result.verdict
+
+
+KEY_UNITS = {"s": "s", "pa": "Pa", "n": "N", "a": "A", "m": "m", "j": "J", "hz": "Hz",
+             "fraction": "1", "run": "run"}
+"""A parameter key's last word -> its SI unit (a key carries its unit, docs/parameters.md;
+``x_per_n``: per newton)."""
+
+
+def parameter_text(key: str, value: float, std: float | None) -> str:
+    """``name = value ± σ`` in the unit a brake engineer reads, e.g. 'delay = 5.99 ± 0.29 ms'
+    for ``actuator_delay.delay_s`` (issue 32: 0.0059941 ± 0.00029 s), 'gain_drift = −3.475 ±
+    0.0014 %/run' for ``gain_drift_per_run``."""
+    name, _, suffix = key.rsplit(".", 1)[-1].rpartition("_")
+    unit = KEY_UNITS.get(suffix)
+    if unit is not None and name.endswith("_per"):
+        name, unit = name.removesuffix("_per"), f"1/{unit}"
+    if unit is None or unit == "1":
+        name = key.rsplit(".", 1)[-1]
+    if unit is None:
+        return f"{name} = {value:.4g}" + ("" if std is None else f" ± {std:.2g}")
+    shown = display(value, unit, ".4g")
+    if std is None:
+        return f"{name} = {shown}"
+    number, _, unit_shown = shown.partition(" ")
+    return f"{name} = {number} ± {display(std, unit, '.2g').partition(' ')[0]} {unit_shown}"

@@ -1,6 +1,6 @@
-"""The diagnosis page's first screen: the verdict in words and the one figure that shows it
-(the measured signal, the model before and after, in the window where the starting model
-misses most, the residuals below). It draws the diagnosis' own simulations
+"""The figure on the diagnosis page's first screen, under the verdict's sentence
+(``report.words``): the measured signal, the model before and after, in the window where the
+starting model misses most, the residuals below. It draws the diagnosis' own simulations
 (``Diagnosis.evidence``); choosing where to look is all it works out."""
 
 from __future__ import annotations

@@ -303,7 +303,7 @@ def _balance_windows(b: br.Braking, params: RigParameters, terms: Sequence[Term[
     """The F_x reading's mean excess over the flywheel's momentum balance in windows of a
     stop (m_f Δv + ∫(F_x + α_d v² + F_f) dt over the window's length), the terms' means
     there, and the owned columns (the mass's Δv and the drag's v², same means); None: no
-    window. Windows start KNOWN_RATE_HZ apart, on the flywheel and above the stop speed."""
+    window. Windows start 1/KNOWN_RATE_HZ apart, on the flywheel and above the stop speed."""
     p = params.vector()
     width = round(BALANCE_WINDOW_S * b.run.rate_hz)
     on = np.flatnonzero((b.time_s > b.start_s) & (b.load > br.LOADED_N)
@@ -323,7 +323,7 @@ def _balance_windows(b: br.Braking, params: RigParameters, terms: Sequence[Term[
     starts = np.arange(0, span.size - width, max(1, round(b.run.rate_hz / KNOWN_RATE_HZ)))
     means = (values[starts + width] - values[starts]) / (b.time_s[span][starts + width]
                                                          - b.time_s[span][starts])[:, None]
-    return means[:, 0], means[:, 1:1 + len(terms)], -means[:, 1 + len(terms):]
+    return means[:, 0], means[:, 1:1 + len(terms)], means[:, 1 + len(terms):]
 
 
 def _slip_noise(b: br.Braking, index: np.ndarray) -> np.ndarray:

@@ -112,16 +112,14 @@ class FlywheelLibrary(BrakingLibrary):
                          b.run.rate_hz)
         if index.size < 20:
             return None
-        p = params.vector()
         dt = np.diff(b.time_s, prepend=b.time_s[0])
         speed = b.speed_m_s
-        resisting = b.force + el.drag_forces(p, speed) + el.flywheel_extra_force(p, speed)
-        impulse = np.cumsum(resisting * dt)
+        balance = momentum_balance(b, params)
+        impulse = balance - el.translational_mass(params.vector()) * speed
         columns = [np.cumsum(variable(t, b, params) * dt) for t in terms or self.terms]
         owned = [speed, np.cumsum(speed * speed * dt)]
-        return about_run_mean((el.translational_mass(p) * speed + impulse)[index],
-                               np.column_stack(columns)[index], np.column_stack(owned)[index],
-                               float(np.std(impulse[index])))
+        return about_run_mean(balance[index], np.column_stack(columns)[index],
+                               np.column_stack(owned)[index], float(np.std(impulse[index])))
 
     def law(self, written: str, params: RigParameters) -> str:
         return f"m_f·v̇ = −F_x − α_d·v² {written}"
@@ -287,6 +285,16 @@ class FxChannelLibrary(Library[tuple[ClassifiedRun, "br.Braking | None"]]):
         return f"F_x,read = F_x{shown} {written}"
 
 
+def momentum_balance(b: br.Braking, params: RigParameters) -> np.ndarray:
+    """The flywheel's momentum balance from the run's start, m_f v + ∫(F_x + α_d v² + F_f)
+    dt, (n,) [N s]: constant where the model holds, whatever it misses integrated."""
+    p = params.vector()
+    dt = np.diff(b.time_s, prepend=b.time_s[0])
+    speed = b.speed_m_s
+    resisting = b.force + el.drag_forces(p, speed) + el.flywheel_extra_force(p, speed)
+    return el.translational_mass(p) * speed + np.cumsum(resisting * dt)
+
+
 BALANCE_WINDOW_S = 1.0  # the flywheel's speed noise over m_f·Δv falls with the window
 
 
@@ -313,10 +321,9 @@ def _balance_windows(b: br.Braking, params: RigParameters, terms: Sequence[Term[
     span = np.arange(on[0], on[-1] + 1)
     dt = np.diff(b.time_s, prepend=b.time_s[0])[span]
     speed = b.speed_m_s[span]
-    resisting = b.force[span] + el.drag_forces(p, speed) + el.flywheel_extra_force(p, speed)
     time = br.run_time_s(b.run)
     values = np.column_stack([
-        el.translational_mass(p) * speed + np.cumsum(resisting * dt),
+        momentum_balance(b, params)[span],
         np.cumsum(term_columns(terms, source, params, span, _fx_signals(b.run, time, span))
                   * dt[:, None], axis=0),
         el.translational_mass(p) * speed, np.cumsum(speed * speed * dt)])

@@ -16,7 +16,7 @@ from .csv_io import read_csv, read_named, run_name
 from .errors import RunFormatError
 from .mapping import Mapping
 from .run import SIGNALS, Run
-from .timebase import split_at_gaps, time_base_notes
+from .timebase import rate_change_note, split_at_gaps, time_base_notes
 from .workbook import SUFFIXES as WORKBOOK_SUFFIXES
 from .workbook import read_workbook
 
@@ -162,10 +162,13 @@ def read_campaign(folder: Path, mapping: Mapping | None = None,
 def _read_parts(path: Path, mapping: Mapping | None, name: str | None = None
                 ) -> tuple[tuple[Run, ...], tuple[str, ...]]:
     """The run of ``path`` as its parts (split at long gaps), and what reading and
-    splitting it had to say."""
-    run = read_run(path, mapping, name)
+    splitting it had to say: its time base judged as :func:`read_run` judges it, the split
+    speaking for its gaps (a gap while braking had been told twice, then its part left
+    out a third time)."""
+    run = _read_any(Path(path), mapping, name)
     split = split_at_gaps(run)
-    return tuple(split.parts), (*run.notes, *split.notes)
+    rate = rate_change_note(run)
+    return tuple(split.parts), (*run.notes, *([rate] if rate else []), *split.notes)
 
 
 def _campaign_name(folder: Path, source: Path) -> str:

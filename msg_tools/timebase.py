@@ -151,7 +151,7 @@ def time_base_notes(run: Run) -> tuple[str, ...]:
     acts on the loaded wheel (no stop is measured across it: a campaign reader splits the
     run there and leaves the part begun mid-stop out), and a rate that changes within the
     run (it is resampled at its mean rate for the model)."""
-    notes = [note] if (note := _rate_change(run)) else []
+    notes = [note] if (note := rate_change_note(run)) else []
     clock = fixed_rate_clock(run.time_s)
     if clock is not None:
         braking = (run.pressure_pa > BRAKING_PRESSURE_PA) & (run.vertical_load_n > CONTACT_LOAD_N)
@@ -163,7 +163,7 @@ def time_base_notes(run: Run) -> tuple[str, ...]:
     return tuple(notes)
 
 
-def _rate_change(run: Run) -> str | None:
+def rate_change_note(run: Run) -> str | None:
     """A rate at the run's start unlike the one at its end, in words (None: one rate). On
     its fast clock the slow part's samples read as one-sample gaps, interpolated."""
     quarter = max(2, run.time_s.size // 4)

@@ -436,3 +436,20 @@ def test_a_log_that_changes_its_rate_says_so_when_read(tmp_path, csv_file):
     notes = read_run(tmp_path / "switched.csv").notes
     assert any("1000 Hz at its start and 500 Hz at its end" in n for n in notes), notes
     assert not read_run(csv_file).notes
+
+
+def test_a_campaign_tells_a_gap_while_braking_once_with_what_it_cost(tmp_path, reference):
+    """The reader's note on the gap and the split's had both told it, then the part it left
+    out a third time."""
+    run = simulate(reference, sc.constant_pressure_test(reference, 30e5)).to_run(3)
+    on = np.flatnonzero(run.current_a > 0.5 * run.current_a.max())
+    lost = slice(on[len(on) // 3], on[len(on) // 3] + round(2.0 * run.rate_hz))
+    keep = np.r_[0:lost.start, lost.stop:len(run)]
+    folder = tmp_path / "campaign"
+    folder.mkdir()
+    write_csv(dataclasses.replace(run, time_s=run.time_s[keep],
+                                  **{s: getattr(run, s)[keep] for s in SIGNALS}),
+              folder / "brake_const_30bar.csv")
+    problems = read_campaign(folder).problems
+    assert len([p for p in problems if "2 s missing" in p]) == 1, problems
+    assert any("begins mid-stop" in p for p in problems), problems

@@ -170,16 +170,16 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 def cmd_compare(args: argparse.Namespace) -> int:
     from landing_gear_sim.calibration.plausibility import check_units
-    from landing_gear_sim.calibration.runs import classify_all
+    from landing_gear_sim.calibration.runs import classified
     from landing_gear_sim.calibration.validate import compare
     from landing_gear_sim.report.figures import DISPLAY_UNITS
     from landing_gear_sim.report.pages import text_table
     from landing_gear_sim.report.validation import plot_overlay
 
     check_outputs(files=[args.plot])
-    measured, simulated = read_one(args.measured, mapping_of(args)), read_one(args.simulated)
-    check_units(classify_all([measured]), params_of(args))  # before a fit % of −600,000
-    comparison = compare(measured, simulated)
+    measured = classified(read_one(args.measured, mapping_of(args)))  # once: compare keeps it
+    check_units([measured], params_of(args))  # before a fit % of −600,000
+    comparison = compare(measured, read_one(args.simulated))
     for note in comparison.notes:
         progress(f"note: {note}")
     rows = []

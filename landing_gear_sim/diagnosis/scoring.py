@@ -55,6 +55,23 @@ def channel_fits(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequen
                  smooth_hz: float | None = None) -> dict[str, float]:
     """Fit % per channel of ``simulated`` against ``runs``, pooled (each run's own mean
     removed); with ``smooth_hz``, of both low-passed there (zero phase)."""
+    errors, spreads, _ = _pooled_squares(runs, simulated, channels, smooth_hz)
+    return {c: round(100.0 * (1.0 - math.sqrt(errors[c] / spreads[c])), 2)
+            for c in channels if spreads[c] > 0}
+
+
+def channel_rmse(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequence[str]
+                 ) -> dict[str, float]:
+    """RMSE per channel of ``simulated`` against ``runs``, pooled [the channel's SI unit]."""
+    errors, _, count = _pooled_squares(runs, simulated, channels)
+    return {c: math.sqrt(errors[c] / count) for c in channels}
+
+
+def _pooled_squares(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequence[str],
+                    smooth_hz: float | None = None
+                    ) -> tuple[dict[str, float], dict[str, float], int]:
+    """Per channel, the squared errors of ``simulated`` and the squared spread of ``runs``
+    about each run's mean, summed over the runs, and the samples summed over."""
     errors: dict[str, float] = dict.fromkeys(channels, 0.0)
     spreads: dict[str, float] = dict.fromkeys(channels, 0.0)
     for run, sim in zip(runs, simulated, strict=True):
@@ -65,17 +82,7 @@ def channel_fits(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequen
                 y, model = (lowpass(v, run.rate_hz, cutoff) for v in (y, model))
             errors[c] += float(np.sum((y - model) ** 2))
             spreads[c] += float(np.sum((y - y.mean()) ** 2))
-    return {c: round(100.0 * (1.0 - math.sqrt(errors[c] / spreads[c])), 2)
-            for c in channels if spreads[c] > 0}
-
-
-def channel_rmse(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequence[str]
-                 ) -> dict[str, float]:
-    """RMSE per channel of ``simulated`` against ``runs``, pooled [the channel's SI unit]."""
-    return {c: float(np.sqrt(np.mean(np.concatenate(
-        [(getattr(run, c) - getattr(sim, c)) ** 2 for run, sim in zip(runs, simulated,
-                                                                      strict=True)]))))
-            for c in channels}
+    return errors, spreads, sum(len(run) for run in runs)
 
 
 def effective_count(residual: np.ndarray) -> float:

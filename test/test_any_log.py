@@ -3,15 +3,21 @@ datasheet naming what differs from the reference, one command to a verdict."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 import yaml
 
-from landing_gear_sim.calibration.campaign import generate_campaign
-from landing_gear_sim.diagnosis.diagnose import diagnose
+from landing_gear_sim.calibration.campaign import NOISE, generate_campaign, rig_like
+from landing_gear_sim.calibration.identify import identify
+from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, diagnose
+from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
+from landing_gear_sim.model import scenario as sc
+from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import load_parameters
-from msg_tools.csv_io import read_csv
+from msg_tools.csv_io import read_csv, write_csv
 from msg_tools.errors import RunFormatError
 from msg_tools.io import read_campaign
 
@@ -68,3 +74,104 @@ def test_a_slow_valves_step_log_and_its_datasheet_give_its_delay_in_one_command(
     finding = result.findings[0]
     assert finding.held_out is not None and finding.held_out < 0
     assert finding.parameters["delay_s"] == pytest.approx(delay, rel=0.1)
+
+
+def _slow_datasheet(tmp_path):
+    sheet = tmp_path / "datasheet.yaml"
+    sheet.write_text(yaml.safe_dump({"/**": {"ros__parameters": SLOW_VALVE}}))
+    return load_parameters([sheet], over_reference=True)
+
+
+def _step_log(rig, folder, cycles: int, seed: int):
+    """One three-column log of ``cycles`` applies and releases (held 3 s, 3 s apart) at
+    levels the test picks, as a valve's step test on a bench is logged."""
+    top = rig.number(K.ACTUATOR_MAX_CURRENT_A)
+    levels = (0.6, 0.35, 0.8)
+
+    def profile(t):
+        current = np.zeros_like(t)
+        for k in range(cycles):
+            current[(t >= 2.0 + 6.0 * k) & (t < 5.0 + 6.0 * k)] = levels[k % 3] * top
+        return current
+
+    duration = 15.0 if cycles == 1 else 2.0 + 6.0 * cycles
+    result = simulate(rig, sc.actuator_test(rig, profile, duration, "valve_step"))
+    folder.mkdir()
+    write_csv(result.to_run(noise=seed), folder / "full.csv")
+    _three_columns(folder / "full.csv", folder / "valve_step.csv")
+    (folder / "full.csv").unlink()
+    return folder
+
+
+# a release unlike the apply: stiffer while the pressure rises, [Ṗ > 1 bar/s]·ΔP, outside
+# the valve library's exact terms (its sgn Ṗ·ΔP is the two-sided one)
+RISING_STIFFER = basis.product_code(basis.factor_code(basis.PRESSURE_RATE, basis.STEP),
+                                    basis.factor_code(basis.VALVE_ERROR, basis.IDENTITY))
+
+
+def _asymmetric_slow_valve(datasheet, seed: int):
+    rng = np.random.default_rng(seed)
+    rig = rig_like(datasheet, rng).replace({**NOISE, "elements.actuator_delay": True}, "noise")
+    delay, stiffer = rng.uniform(0.05, 0.15), rng.uniform(0.4, 0.8)
+    return rig.replace({K.ACTUATOR_DELAY_S: delay, K.VALVE_TERMS[0][0]: float(RISING_STIFFER),
+                        K.VALVE_TERMS[0][1]: stiffer}, "hidden effect"), delay
+
+
+def test_a_step_log_of_a_slow_valve_gives_its_delay_and_a_release_unlike_its_apply(tmp_path):
+    """Issue 43's benchmark case as a test: one step log (three applies and releases) of a
+    valve 4x slower than the reference, its map ±3 % off its datasheet, a 50-150 ms delay
+    and a release unlike its apply, drawn here. Its later steps are held out in time: they
+    had been simulated from zero pressure in the middle of a hold (18 bar off at their
+    first sample), and the map was the datasheet's (no ramp run)."""
+    datasheet = _slow_datasheet(tmp_path)
+    rig, delay = _asymmetric_slow_valve(datasheet, 51)
+    runs = read_campaign(_step_log(rig, tmp_path / "logs", 3, 51)).runs
+    result = diagnose(runs, datasheet)
+    causes = {f.cause: f for f in result.findings}
+    assert result.verdict == "actuator_delay", [(f.cause, f.delta_bic, f.held_out, f.reason)
+                                                for f in result.candidates]
+    assert causes["actuator_delay"].parameters["delay_s"] == pytest.approx(delay, rel=0.1)
+    valve = causes.get("discovered")
+    assert valve is not None and valve.family == "valve", result.findings
+    assert valve.parameters.get("sgn Ṗ·ΔP", 0.0) > 0.0, valve.term  # stiffer rising
+    assert valve.held_out is not None and valve.held_out < 0
+    assert valve.fit_after["pressure_pa"] >= 96.0  # the later steps, as held out (were 91 %)
+    # a candidate whose model diverged on the held-out part (nan) had met every rule
+    assert all(math.isfinite(f.held_out) for f in result.candidates
+               if f.accepted and f.held_out is not None)
+
+
+def test_a_log_of_one_apply_and_one_release_says_what_one_more_step_would_settle(tmp_path):
+    """One apply and one release of that valve: the delay fitted on the apply cannot be
+    checked on a release unlike it; the verdict is inconclusive and says so."""
+    datasheet = _slow_datasheet(tmp_path)
+    rig, _ = _asymmetric_slow_valve(datasheet, 52)
+    result = diagnose(read_campaign(_step_log(rig, tmp_path / "logs", 1, 52)).runs,
+                      datasheet)
+    assert result.verdict == INCONCLUSIVE
+    assert any("one more step" in p and "actuator_delay" in p for p in result.problems), \
+        result.problems
+
+
+def test_a_step_log_without_a_ramp_reads_the_valves_map_from_its_held_levels(tmp_path):
+    datasheet = _slow_datasheet(tmp_path)
+    k1 = datasheet.number(K.ACTUATOR_MAP_K1_PA_PER_A) * np.random.default_rng(53).uniform(
+        1.04, 1.08)
+    rig = datasheet.replace({**NOISE, K.ACTUATOR_MAP_K1_PA_PER_A: k1}, "the rig's map")
+    calibration = identify(read_campaign(_step_log(rig, tmp_path / "logs", 3, 53)).runs,
+                           datasheet, friction=False, jackknife=False)
+    assert calibration.params.number(K.ACTUATOR_MAP_K1_PA_PER_A) == pytest.approx(k1,
+                                                                                  rel=0.01)
+    assert not any("static map" in p for p in calibration.problems), calibration.problems
+
+
+def test_a_run_that_starts_with_the_brake_applied_starts_where_the_valve_was():
+    """A run's simulation starts settled on its first current (a part of a run cut in time
+    starts mid-hold), also behind a transport delay (whose register had made the settling
+    stop at once, at zero)."""
+    rig = load_parameters().replace({"elements.actuator_delay": True,
+                                     K.ACTUATOR_DELAY_S: 0.08}, "a delay")
+    level = 0.5 * rig.number(K.ACTUATOR_MAX_CURRENT_A)
+    result = simulate(rig, sc.actuator_test(rig, sc.constant(level), 1.0))
+    pressure = result.to_run().pressure_pa
+    assert pressure[0] == pytest.approx(pressure[-1], rel=1e-6) and pressure[0] > 1e5

@@ -3,8 +3,10 @@ code under test): the verdict *and* the recovered key parameter."""
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import html
+import io
 import json
 import math
 import re
@@ -12,6 +14,8 @@ import signal
 import subprocess
 import sys
 import time
+from html.parser import HTMLParser
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -202,15 +206,36 @@ def test_unknown_element_to_remove_is_a_clear_error(reference, tmp_path):
         diagnose(runs[:1], reference, without=["gearwalk"])
 
 
-def test_cli_writes_the_contract_json_and_the_report(reference, tmp_path, capsys):
+@dataclasses.dataclass(frozen=True)
+class _Diagnosed:
+    """What ``diagnose --json --report -o`` left, and what it printed."""
+    code: int
+    document: dict
+    page: str
+    printed: str
+    extended: Path
+
+
+@pytest.fixture(scope="module")
+def delay_diagnosed(reference, tmp_path_factory) -> _Diagnosed:
+    """One CLI diagnosis of a campaign hiding a 6 ms valve delay, read by several tests."""
+    tmp_path = tmp_path_factory.mktemp("delay")
     folder = tmp_path / "campaign"
     _campaign(reference, folder, 109, lambda rng: {
         "elements.actuator_delay": True, "actuator.delay_s": 0.006})
     out = tmp_path / "diagnosis.json"
-    code = main(["diagnose", str(folder), "--json", str(out), "--report",
-                 str(tmp_path / "report"), "-o", str(tmp_path / "extended.yaml")])
-    assert code == 0
-    document = json.loads(out.read_text())
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        code = main(["diagnose", str(folder), "--json", str(out), "--report",
+                     str(tmp_path / "report"), "-o", str(tmp_path / "extended.yaml")])
+    return _Diagnosed(code, json.loads(out.read_text()),
+                      (tmp_path / "report" / "index.html").read_text(), printed.getvalue(),
+                      tmp_path / "extended.yaml")
+
+
+def test_cli_writes_the_contract_json_and_the_report(delay_diagnosed):
+    assert delay_diagnosed.code == 0
+    document = delay_diagnosed.document
     assert document["verdict"] == "actuator_delay"
     finding = document["findings"][0]
     assert {"cause", "parameters", "evidence", "fit_before", "fit_after",
@@ -218,16 +243,122 @@ def test_cli_writes_the_contract_json_and_the_report(reference, tmp_path, capsys
     assert finding["fit_after"]["pressure_pa"] > finding["fit_before"]["pressure_pa"]
     assert set(document["baseline"]) >= {"pressure_pa", "wheel_speed_rad_s"}
     assert len(document["consistency_calibrated"]) == len(document["consistency"]) > 0
-    page = (tmp_path / "report" / "index.html").read_text()
+    page = delay_diagnosed.page
     assert "calibrated model" in page and "extended model" in page
-    out = capsys.readouterr().out
+    out = delay_diagnosed.printed
     assert "VERDICT: actuator_delay" in out
     headline = re.search(r"actuator_delay: the valve answers later than the model's, delay = "
                          r"(\d\.\d+) ± [\d.]+ ms; on the runs it was not fitted on the brake "
                          r"pressure fits [\d.]+ → [\d.]+ % \(RMSE [\d.]+ → [\d.]+ bar\)", out)
     assert headline and abs(float(headline[1]) - 6.0) < 0.3, out
     assert html.escape(headline[0]) in page
-    assert main(["params", "--config", str(tmp_path / "extended.yaml")]) == 0
+    assert main(["params", "--config", str(delay_diagnosed.extended)]) == 0
+
+
+class _Tables(HTMLParser):
+    """The page's tables by the heading of their section: rows of cell texts."""
+
+    def __init__(self, page: str) -> None:
+        super().__init__()
+        self.tables: dict[str, list[list[str]]] = {}
+        self._heading: str | None = None
+        self._text = ""
+        self._rows: list[list[str]] | None = None
+        self.feed(page)
+
+    def handle_starttag(self, tag: str, attrs) -> None:
+        if tag in ("h2", "td", "th"):
+            self._text = ""
+        elif tag == "table" and self._heading is not None:
+            self._rows = self.tables.setdefault(self._heading, [])
+        elif tag == "tr" and self._rows is not None:
+            self._rows.append([])
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag == "h2":
+            self._heading = self._text
+        elif tag in ("td", "th") and self._rows is not None:
+            self._rows[-1].append(self._text)
+        elif tag == "table":
+            self._rows = None
+
+    def handle_data(self, data: str) -> None:
+        self._text += data
+
+
+def _rows(tables: _Tables, heading: str) -> list[dict[str, str]]:
+    header, *rows = tables.tables[heading]
+    return [dict(zip(header, row, strict=True)) for row in rows]
+
+
+def _number(text: str) -> float | None:
+    return None if text == "-" else float(text)
+
+
+def _fits(text: str) -> dict[str, float]:
+    pairs = (item.split(": ") for item in text.split(", ") if item)
+    return {channel: float(value.removesuffix(" %")) for channel, value in pairs}
+
+
+_CELL = re.compile(r"(?P<deviation>\S+) ± (?P<std>\S+) (?P<unit>.+?) \((?P<phase>.*)\)"
+                   r"(?P<violated> VIOLATED)?$")
+
+
+def test_every_number_in_the_pages_tables_is_the_one_in_the_json(delay_diagnosed):
+    """Issue 42: the consistency table had put the calibrated model's F_x check beside the
+    extended model's F_z check of the same run. Read back from the rendered page, each row
+    of each table is the JSON's, and a calibrated cell is the check measuring the same."""
+    document, tables = delay_diagnosed.document, _Tables(delay_diagnosed.page)
+
+    baseline = {row["channel"]: float(row["fit %"])
+                for row in _rows(tables, "Starting model, calibrated: fit %")}
+    assert baseline == pytest.approx(document["baseline"], abs=0.006)
+
+    findings = _rows(tables, "Verdict")
+    assert len(findings) == len(document["findings"]) > 0
+    for row, finding in zip(findings, document["findings"], strict=True):
+        assert row["cause"].split(" ")[0] == finding["cause"]
+        assert _number(row["ΔBIC"]) == pytest.approx(finding["delta_bic"], abs=0.051)
+        assert _number(row["held-out improvement"]) == pytest.approx(
+            -finding["held_out_delta"], abs=0.051)
+        assert _fits(row["held-out fit before"]) == pytest.approx(finding["fit_before"],
+                                                                  abs=0.006)
+        assert _fits(row["after"]) == pytest.approx(finding["fit_after"], abs=0.006)
+
+    candidates = _rows(tables, "Candidates")
+    assert len(candidates) == len(document["candidates"]) > 0
+    for row, candidate in zip(candidates, document["candidates"], strict=True):
+        assert (row["cause"], row["accepted"] == "yes") == (candidate["cause"],
+                                                           candidate["accepted"])
+        assert row["why"] == candidate.get("reason", "")
+        for key, value in candidate["parameters"].items():
+            shown = re.search(rf"(?:^|, ){re.escape(key)} = (\S+?)(,|$)", row["key parameters"])
+            assert shown and float(shown[1]) == pytest.approx(value, rel=6e-4), key
+        for column, key in (("ΔBIC", "delta_bic"), ("held-out improvement", "held_out_delta")):
+            expected = candidate[key]
+            sign = -1 if key == "held_out_delta" else 1
+            assert _number(row[column]) == (None if expected is None else pytest.approx(
+                sign * expected, abs=0.051)), column
+
+    consistency = _rows(tables, "Consistency of what the rig measures twice")
+    assert len(consistency) == len(document["consistency"]) > 0
+    calibrated = {(c["relation"], c["run"], c["phase"]): c
+                  for c in document["consistency_calibrated"]}
+    for row, check in zip(consistency, document["consistency"], strict=True):
+        after = _CELL.match(row["extended model"])
+        assert after and (row["relation"], row["run"], after["phase"]) == (
+            check["relation"], check["run"], check["phase"])
+        assert float(after["deviation"]) == pytest.approx(check["deviation"], rel=6e-4,
+                                                          abs=1e-12)
+        assert bool(after["violated"]) == check["violated"]
+        same = calibrated.get((check["relation"], check["run"], check["phase"]))
+        before = _CELL.match(row["calibrated model"])
+        if same is not None:  # what measures the same is what stands beside it
+            assert before and before["phase"] == check["phase"], row
+        if before:
+            shown = calibrated[(row["relation"], row["run"], before["phase"])]
+            assert float(before["deviation"]) == pytest.approx(shown["deviation"], rel=6e-4,
+                                                               abs=1e-12)
 
 
 @pytest.mark.parametrize(("key", "value", "std", "text"), [

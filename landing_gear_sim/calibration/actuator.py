@@ -4,6 +4,7 @@ second-order fit to it, refined by an output-error fit in the time domain."""
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -12,7 +13,9 @@ import numpy as np
 import scipy.signal
 from scipy.optimize import least_squares
 
+from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.statistics import Estimate, covariance_std
+from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.actuator import actuator_pressure, second_order_response
@@ -45,23 +48,75 @@ def fit_static_map(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
     map's generic slot k3 of ``p`` (read around, as the other calibrations read around
     theirs)."""
     current = np.concatenate([r.current_a for r in runs])
-    pressure = SensorModel.of(p).true_pressure(np.concatenate([r.pressure_pa for r in runs]))
+    pressure = np.concatenate([r.pressure_pa for r in runs])
+    return _fit_map(current, pressure, p, STATIC_MAP, tuple(r.name for r in runs),
+                    "static-map least squares")
+
+
+SETTLED_TIME_CONSTANTS = 5.0  # a hold is settled this many of A(s)'s 1/(ζ ω_n) after its step
+MIN_HELD_SAMPLES = 20  # a hold's settled part shorter than this is no level
+
+
+def held_levels(runs: Sequence[Run], p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
+    """The settled samples of the runs' held commands: (current [A], pressure [Pa]). A
+    hold's samples count from its later half, and from SETTLED_TIME_CONSTANTS of the
+    datasheet's A(s) after its step (a slow valve's delay is in neither)."""
+    settle_s = SETTLED_TIME_CONSTANTS / (
+        2 * math.pi * p.number(K.ACTUATOR_NATURAL_FREQUENCY_HZ)
+        * p.number(K.ACTUATOR_DAMPING_RATIO))
+    currents, pressures = [], []
+    for run in runs:
+        command = run.command_a if isinstance(run, ClassifiedRun) else run.current_a
+        edges = np.concatenate([[0], np.flatnonzero(np.diff(command)) + 1, [command.size]])
+        for first, end in itertools.pairwise(edges.tolist()):
+            start = first + max(round(settle_s * run.rate_hz), (end - first) // 2)
+            if end - start >= MIN_HELD_SAMPLES:
+                currents.append(command[start:end])
+                pressures.append(run.pressure_pa[start:end])
+    if not currents:
+        return np.zeros(0), np.zeros(0)
+    return np.concatenate(currents), np.concatenate(pressures)
+
+
+def fit_map_to_holds(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
+    """k1 (and k2 where two levels above the dead-band tell them apart) from the settled
+    pressures of held commands (:func:`held_levels`): a step log's map, where no ramp was
+    run. The dead-band and the saturation stay the datasheet's (a few levels do not show
+    them). Without it a step log was judged on the reference's map, and a delay fitted
+    on one step was checked on another 3 % of map off."""
+    current, pressure = held_levels(runs, p)
+    deadband = p.number(K.ACTUATOR_DEADBAND_CURRENT_A)
+    levels = np.unique(np.round(current[current > deadband], 3))
+    if levels.size == 0:
+        raise IdentificationError("no held command above the dead-band to read the map at")
+    keys = STATIC_MAP[1:3] if levels.size >= 2 else STATIC_MAP[1:2]
+    return _fit_map(current, pressure, p, keys, tuple(r.name for r in runs),
+                    f"settled pressures of {levels.size} held commands")
+
+
+def _fit_map(current: np.ndarray, pressure_measured: np.ndarray, p: RigParameters,
+             keys: Sequence[str], names: tuple[str, ...], method: str) -> list[Estimate]:
+    """The map's ``keys`` (of STATIC_MAP) by least squares on (current, pressure) samples,
+    the others kept at ``p``'s."""
+    pressure = SensorModel.of(p).true_pressure(pressure_measured)
     max_current, k3 = (p.number(k) for k in (K.ACTUATOR_MAX_CURRENT_A,
                                              K.ACTUATOR_EXTRA_MAP_PA_PER_A3))
+    values = np.array([p.number(k) for k in STATIC_MAP])
+    free = np.array([k in keys for k in STATIC_MAP])
     scale = np.array([p.number(k) or 1.0 for k in STATIC_MAP])
     scale[0] = max(scale[0], 0.05)
 
     def residual(theta: np.ndarray) -> np.ndarray:
-        deadband, k1, k2, max_pressure = theta * scale
+        trial = values.copy()
+        trial[free] = theta * scale[free]
+        deadband, k1, k2, max_pressure = trial
         return (el.valve_map(current, max_current, deadband, k1, k2, k3, max_pressure)
                 - pressure) / PA_PER_BAR
 
-    start = np.array([p.number(k) for k in STATIC_MAP]) / scale
-    fit = least_squares(residual, start, x_scale="jac")
-    std = covariance_std(fit, 4) * scale
-    names = tuple(r.name for r in runs)
-    return [Estimate(k, float(v), float(s), names, "static-map least squares")
-            for k, v, s in zip(STATIC_MAP, fit.x * scale, std, strict=True)]
+    fit = least_squares(residual, values[free] / scale[free], x_scale="jac")
+    std = covariance_std(fit, int(free.sum())) * scale[free]
+    return [Estimate(k, float(v), float(e), names, method)
+            for k, v, e in zip(keys, fit.x * scale[free], std, strict=True)]
 
 
 def actuator_frf(run: Run, params: RigParameters) -> FrfEstimate:

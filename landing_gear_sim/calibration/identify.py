@@ -25,6 +25,7 @@ from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.actuator import (
     FrfEstimate,
     fit_actuator_dynamics,
+    fit_map_to_holds,
     fit_static_map,
 )
 from landing_gear_sim.calibration.friction import KEYS as FRICTION_KEYS
@@ -131,8 +132,12 @@ def _identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool,
         found, state.frf = fit_actuator_dynamics(dynamic, state.params)
         state.adopt(found)
 
-    state.step("valve static map", ramps, "quasi-static ramp",
-               lambda: state.adopt(fit_static_map(ramps, state.params)))
+    if ramps or not dynamic:
+        state.step("valve static map", ramps, "quasi-static ramp",
+                   lambda: state.adopt(fit_static_map(ramps, state.params)))
+    else:  # a step log: the map's gain from its held levels
+        state.step("valve static map (held levels)", dynamic, "actuator",
+                   lambda: state.adopt(fit_map_to_holds(dynamic, state.params)))
     state.step("actuator dynamics A(s)", dynamic, "actuator steps/sweep", dynamics)
     _braking_steps(state, braking, fix_theta3, friction, jackknife)
     return Identification(state.params, tuple(state.estimates),

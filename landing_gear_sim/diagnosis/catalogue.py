@@ -281,7 +281,11 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
     points = [window.unit(np.array([*(s or [r.number(k) for k in own]),
                                     *(r.number(k) for k in free)]))
               for s in own_starts for r in references]
-    initial = [float(np.sum(residual(u) ** 2)) for u in points]
+    # a start the model does not survive (an unstable valve: inf or nan) is no start
+    initial = [cost if math.isfinite(cost := float(np.sum(residual(u) ** 2))) else math.inf
+               for u in points]
+    if not math.isfinite(min(initial)):
+        raise IdentificationError(f"{candidate.cause}: the model diverges from every start")
     order = [i for i in np.argsort(initial)[:tries] if initial[i] <= START_RATIO * min(initial)]
     start = points[order[0]]
     if len(order) > 1:

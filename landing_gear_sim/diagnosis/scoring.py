@@ -158,6 +158,7 @@ def slip_reach(run: ClassifiedRun) -> float:
 
 
 SETTLED_SPLIT_S = 0.5  # a run cut in time is cut where the current has held this long
+CUT_FIRST, CUT_LATER = "before", "after"  # a run cut in time: its parts' names' suffixes
 
 
 def _held_out_in_time(fit: list[ClassifiedRun]
@@ -179,7 +180,8 @@ def _held_out_in_time(fit: list[ClassifiedRun]
         return fit, []
     cut = int(candidates[np.argmin(np.abs(candidates - len(run) // 2))])
     first, later = (ClassifiedRun.of(run.part(part, f"{run.name} ({which})"))
-                    for part, which in ((slice(0, cut), "before"), (slice(cut, None), "after")))
+                    for part, which in ((slice(0, cut), CUT_FIRST), (slice(cut, None),
+                                                                     CUT_LATER)))
     return [first if r is run else r for r in fit], [later]
 
 
@@ -250,6 +252,8 @@ def _rejection(delta_bic: float, held: HeldOut, at_bound: bool, beyond: str) -> 
         return f"no: ΔBIC {delta_bic:+.0f} is not below {BIC_THRESHOLD:g}"
     if held.delta is None:
         return "no: no held-out run to check it on"
+    if not math.isfinite(held.delta):  # nan passed every comparison below: accepted once
+        return "no: its model diverges on the held-out runs"
     if held.delta >= HELD_OUT_THRESHOLD:
         return (f"no: the held-out runs improve by {-held.delta:+.0f}, not by more than "
                 f"{-HELD_OUT_THRESHOLD:g}")

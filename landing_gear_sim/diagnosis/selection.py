@@ -237,5 +237,5 @@ def ordinary_fit(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     coef, *_ = np.linalg.lstsq(scaled, y, rcond=None)
     residual = y - scaled @ coef
     variance = float(residual @ residual) / effective_count(residual)
-    std = np.sqrt(np.diag(np.linalg.pinv(scaled.T @ scaled)) * variance)
+    std = np.sqrt(np.maximum(np.diag(np.linalg.pinv(scaled.T @ scaled)), 0.0) * variance)
     return coef / spread, np.abs(coef) / np.maximum(std, 1e-300)

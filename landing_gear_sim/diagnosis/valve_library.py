@@ -263,7 +263,10 @@ class ValveDynamicsLibrary(Library[ValveRun]):
             if trial is None or not rows:
                 return None
             design = np.vstack([np.hstack([r.terms, r.owned]) for r in rows])
-            step, z = ordinary_fit(design, np.concatenate([r.error for r in rows]))
+            error = np.concatenate([r.error for r in rows])
+            if not (np.isfinite(design).all() and np.isfinite(error).all()):
+                return None  # a step the valve does not survive (a release fitted on one apply)
+            step, z = ordinary_fit(design, error)
             values, owned = values + step[:values.size], owned + step[values.size:]
             sigma = np.abs(step[:values.size]) / np.maximum(z[:values.size], 1e-300)
             t = np.abs(values) / np.maximum(sigma, 1e-300)

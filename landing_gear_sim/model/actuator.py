@@ -175,17 +175,27 @@ def settled_response(p, matrices, current):
 
 
 @njit(cache=True)
+def settled_state(p, matrices, current_a):
+    """The actuator state settled on ``current_a`` held (zero for a current below the
+    dead-band, where every run of the rig starts): where a run's simulation starts, so a
+    part of a run cut in time starts where the valve was."""
+    xa = actuator_state(matrices)
+    xa[0] = actuator_step(p, matrices, xa, current_a)
+    filled = xa.size  # the delay's register full first (the pressure rests until then)
+    for k in range(100000):
+        before = xa[0]
+        actuator_step(p, matrices, xa, current_a)
+        if k >= filled and abs(xa[0] - before) < 1e-9 and abs(xa[1]) < 1e-6:
+            break
+    return xa
+
+
+@njit(cache=True)
 def settled_states(p, matrices, current):
     """A(s)'s state for a held current sequence as :func:`settled_response` steps it, (n, 3):
     pressure [Pa], its rate [Pa/s], and the delayed static-map pressure [Pa] driving the
     step from each sample to the next (the valve's slot's signals)."""
-    xa = actuator_state(matrices)
-    xa[0] = actuator_step(p, matrices, xa, current[0])
-    for _ in range(100000):
-        before = xa[0]
-        actuator_step(p, matrices, xa, current[0])
-        if abs(xa[0] - before) < 1e-9 and abs(xa[1]) < 1e-6:
-            break
+    xa = settled_state(p, matrices, current[0])
     out = np.empty((current.size, 3))
     newest = PLAY + 1 + int(matrices[ACT_DELAY_STEPS])
     for k in range(current.size):

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, prange
 
-from landing_gear_sim.model.actuator import actuator_matrices, actuator_state, actuator_step
+from landing_gear_sim.model.actuator import actuator_matrices, actuator_step, settled_state
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.plant import (
     CHANNELS,
@@ -40,10 +40,10 @@ def run_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed,
     at every exchange, or empty: the plant's own."""
     x = np.zeros(N_STATES)
     x[SPEED] = initial_speed if contact else 0.0
-    xa = actuator_state(matrices)
+    xa = settled_state(p, matrices, current[0])
     xl = np.zeros(1)
     work = np.zeros((5, N_STATES))
-    pressure, load = 0.0, 0.0
+    pressure, load = xa[0], 0.0
     # a wheel off the ground at rest is a fixed point of the plant (every derivative is
     # exactly 0): stepping it only costs time (~80 % of an actuator run's simulation)
     at_rest = not contact and initial_speed == 0.0
@@ -69,9 +69,10 @@ def run_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed,
 @njit(cache=True)
 def actuator_kernel(p, matrices, current, out):
     """The pressure column ``run_kernel`` records, from the actuator alone (it does not
-    depend on the wheel): ``out[0]`` = 0, ``out[k+1]`` after step k with ``current[k]``."""
-    xa = actuator_state(matrices)
-    out[0] = 0.0
+    depend on the wheel): ``out[0]`` settled on ``current[0]``, ``out[k+1]`` after step k with
+    ``current[k]``."""
+    xa = settled_state(p, matrices, current[0])
+    out[0] = xa[0]
     for k in range(current.shape[0] - 1):
         out[k + 1] = actuator_step(p, matrices, xa, current[k])
 

@@ -7,6 +7,7 @@ for a measured run); everything else from the run's signals.
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -20,6 +21,7 @@ from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import (
     gear_walk_modes,
     load_factor_at,
+    logged_or_set_load_n,
     peak_friction,
     rim_speed_m_s,
     rolling_radius_at,
@@ -56,14 +58,23 @@ class BrakingMetrics:
     gear_walk_frequency_hz: float
     cycling_near_gear_walk: bool
 
-    def to_dict(self) -> dict[str, float | int | bool]:
-        return asdict(self)
+    def to_dict(self) -> dict[str, float | int | bool | None]:
+        """The metrics, what the log could not give (no load cells: friction) as None."""
+        return {k: None if isinstance(v, float) and math.isnan(v) else v
+                for k, v in asdict(self).items()}
 
 
 def braking_window(run: Run) -> slice:
     """From the first brake command (scenario.brake_start_index) to the end of the run."""
     start = brake_start_index(run.current_a, run.rate_hz)
-    if start is None or float(np.max(run.vertical_load_n)) < MIN_LOAD_N:
+    lacking = run.lacks("flywheel_speed_rad_s")
+    if lacking:
+        raise LandingGearSimError(f"{run.name}: {lacking[0]} not logged: the stop's speed, "
+                                  "slip and distance need the flywheel's (the vehicle's) speed")
+    # without a load cell the wheel's contact shows as the flywheel turning
+    touching = (float(np.max(run.vertical_load_n)) >= MIN_LOAD_N if not run.lacks(
+        "vertical_load_n") else float(np.max(np.abs(run.flywheel_speed_rad_s))) > 0.0)
+    if start is None or not touching:
         raise LandingGearSimError(f"{run.name}: not a braking run (no current, or the wheel "
                                   "never touches the flywheel)")
     return slice(start, len(run))
@@ -89,8 +100,8 @@ def stops(run: Run) -> list[Run]:
 def speeds_m_s(run: Run, rig: RigParameters) -> tuple[np.ndarray, np.ndarray]:
     """Flywheel rim (vehicle) speed and wheel peripheral speed at the rolling radius [m/s]."""
     vehicle = rim_speed_m_s(rig, run.flywheel_speed_rad_s)
-    wheel = run.wheel_speed_rad_s * rolling_radius_at(rig, np.maximum(run.vertical_load_n, 0.0))
-    return vehicle, wheel
+    load = np.maximum(logged_or_set_load_n(run, rig), 0.0)
+    return vehicle, run.wheel_speed_rad_s * rolling_radius_at(rig, load)
 
 
 def slip_from(vehicle_m_s: np.ndarray, wheel_m_s: np.ndarray) -> np.ndarray:
@@ -104,10 +115,12 @@ def braking_metrics(run: Run, rig: RigParameters) -> BrakingMetrics:
     t = run.time_s[window]
     vehicle, wheel = speeds_m_s(run, rig)
     speed = vehicle[window]
-    load = run.vertical_load_n[window]
+    load = logged_or_set_load_n(run, rig)[window]
     slip = slip_from(vehicle, wheel)[window]
     loaded = load > MIN_LOAD_N
-    friction = run.longitudinal_force_n[window][loaded] / load[loaded]
+    # without load cells no friction is measured: NaN, 'not logged' in tables and JSON
+    friction = run.longitudinal_force_n[window][loaded] / load[loaded] if not run.lacks(
+        "vertical_load_n", "longitudinal_force_n") else np.full(1, np.nan)
     peak, _ = peak_friction(rig)
     moving = speed > LOCK_MIN_SPEED_M_S
     locked = (slip >= LOCK_SLIP) & moving
@@ -118,7 +131,8 @@ def braking_metrics(run: Run, rig: RigParameters) -> BrakingMetrics:
         stopping_distance_m=float(scipy.integrate.trapezoid(speed, t)),
         stopping_time_s=duration,
         mean_deceleration_m_s2=float(speed[0] - speed[-1]) / max(duration, 1e-9),
-        braking_efficiency=_efficiency(rig, friction, speed[loaded], load[loaded], peak),
+        braking_efficiency=_efficiency(rig, friction, speed[loaded], load[loaded], peak)
+        if np.isfinite(friction).all() else math.nan,
         mean_friction=float(np.mean(friction)),
         peak_friction=peak,
         slip_rms=float(np.sqrt(np.mean(slip[moving] ** 2))) if moving.any() else 0.0,

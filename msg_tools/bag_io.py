@@ -80,6 +80,9 @@ def write_bag(run: Run, path: Path, storage: str = "mcap") -> None:
         raise RunFormatError(f"unknown bag storage {storage!r}; use mcap or sqlite3")
     if path.exists():
         raise RunFormatError(f"{path}: exists already, not overwriting")
+    if run.absent:  # NaN messages would read back as a signal
+        raise RunFormatError(f"{run.source or run.name}: {', '.join(run.absent)} not logged: "
+                             "a bag carries every contract topic; write it as CSV")
     stage = path.with_name(f".{path.name}.part")
     shutil.rmtree(stage, ignore_errors=True)
     # the storage file is named after its folder, and mcap embeds that name: write it in a

@@ -75,7 +75,7 @@ def read_bag(path: Path, name: str | None = None, mapping: Mapping | None = None
         raise RunFormatError(f"{where}: cannot read bag ({exc})") from None
     fields = _on_wheel_base(series, sources, where)
     check_plausible(fields, where)
-    return Run(name=name or path.stem, source=where, notes=tuple(notes), **fields)
+    return Run(name=name or path.stem, source=where, notes=tuple(notes), absent=(), **fields)
 
 
 def _without_interfaces(reader: AnyReader) -> AnyReader:

@@ -16,6 +16,9 @@ from .run import Run
 from .text_table import MASTER_TIME, Table
 from .units import QUANTITY, UNITS, parse_unit
 
+MAY_LACK = ("flywheel_speed_rad_s", "vertical_load_N", "longitudinal_force_N")
+"""The columns a braking log may lack (a logger without load cells or a flywheel encoder)."""
+
 
 def wanted_columns(mapping: Mapping) -> list[str]:
     return [mapping[c].column for c in CSV_COLUMNS]
@@ -38,11 +41,17 @@ def run_from_table(table: Table, where: str, name: str, mapping: Mapping | None 
     fields: dict[str, np.ndarray] = {}
     notes = table.notes
     channels = _channels(table, where, mapping)
+    shape = np.shape(table.columns[channels["time_s"].column])
+    absent = tuple(CSV_TO_FIELD[c] for c in RIG_COLUMNS if c not in channels)
     if not set(RIG_COLUMNS) & set(channels):  # an actuator-only log: the wheel off
-        zeros = np.zeros(np.shape(table.columns[channels["time_s"].column]))
-        fields.update({CSV_TO_FIELD[c]: zeros for c in RIG_COLUMNS})
+        fields.update({CSV_TO_FIELD[c]: np.zeros(shape) for c in RIG_COLUMNS})
         notes += (f"{where}: no wheel, flywheel or load channels: an actuator-only log, "
                   "read with the wheel off the flywheel (they are 0)",)
+        absent = ()
+    elif absent:  # a braking log without load cells or a flywheel encoder
+        fields.update({field: np.full(shape, np.nan) for field in absent})
+        notes += (f"{where}: {', '.join(absent)} not logged: what needs "
+                  f"{'them' if len(absent) > 1 else 'it'} skips this run and says so",)
     uses = Counter(channel.column for channel in channels.values())
     for contract, channel in channels.items():
         raw = table.columns[channel.column]
@@ -53,7 +62,7 @@ def run_from_table(table: Table, where: str, name: str, mapping: Mapping | None 
         fields[CSV_TO_FIELD[contract]] = clock if clock is not None else \
             _to_si(channel, raw, where, table.owned and uses[channel.column] == 1)
     check_plausible(fields, where)
-    return Run(name=name, source=where, notes=notes, **fields)
+    return Run(name=name, source=where, notes=notes, absent=absent, **fields)
 
 
 def _channels(table: Table, where: str, mapping: Mapping) -> dict[str, Channel]:
@@ -66,12 +75,15 @@ def _channels(table: Table, where: str, mapping: Mapping) -> dict[str, Channel]:
             channels[contract] = channel
         else:
             missing.append((contract, channel.column))
-    if missing and [c for c, _ in missing] != list(RIG_COLUMNS):  # all of them: actuator-only
+    lacking = [c for c, _ in missing]
+    if missing and lacking != list(RIG_COLUMNS) and not set(lacking) <= set(MAY_LACK):
         found = ", ".join(table.columns) or "none"
         named = ", ".join(f"{column} for {contract}" for contract, column in missing)
         raise RunFormatError(f"{where}: missing column(s) {named} (found {found}); name "
                              "them in a column-mapping file (an actuator-only log may leave "
-                             "out all four wheel, flywheel and load channels, not some)")
+                             "out all four wheel, flywheel and load channels; a braking log "
+                             "its load cells or its flywheel encoder, not its time, current, "
+                             "pressure or wheel speed)")
     return channels
 
 

@@ -66,11 +66,12 @@ def csv_chunks(run: Run, rows: int = CHUNK_ROWS) -> Iterator[str]:
     """The contract CSV text of ``run`` in pieces of ``rows`` rows, header first: a long run
     is written without its whole text in memory (an hour at 1 kHz, 206 MB of text, had
     taken ~1.6 GB as one list of Python numbers and lines)."""
-    yield ",".join(CSV_COLUMNS) + "\n"
-    formats = [TIME_FORMAT if c == "time_s" else VALUE_FORMAT for c in CSV_COLUMNS]
+    columns = [c for c in CSV_COLUMNS if CSV_TO_FIELD[c] not in run.absent]  # as logged
+    yield ",".join(columns) + "\n"
+    formats = [TIME_FORMAT if c == "time_s" else VALUE_FORMAT for c in columns]
     for start in range(0, len(run), rows):
         block = np.column_stack([getattr(run, CSV_TO_FIELD[c])[start:start + rows]
-                                 / CSV_SCALE_TO_SI[c] for c in CSV_COLUMNS]).tolist()
+                                 / CSV_SCALE_TO_SI[c] for c in columns]).tolist()
         yield "".join(",".join(format(value, f) for value, f in zip(row, formats, strict=True))
                       + "\n" for row in block)
 

@@ -216,7 +216,7 @@ def at_times(run: Run, times_s: np.ndarray) -> Run:
     linear = {name: np.interp(times_s, run.time_s, getattr(run, name))
               for name in SIGNALS if name != "current_a"}
     return Run(name=run.name, source=run.source, time_s=times_s, current_a=run.current_a[held],
-               **linear)
+               absent=run.absent, **linear)
 
 
 def is_uniform(run: Run, tolerance: float = 1e-6) -> bool:

@@ -35,6 +35,9 @@ class Run:
     notes: tuple[str, ...] = field(default=(), compare=False)
     """What reading had to do to the file (e.g. a last line cut short, dropped): for the
     user, beside the run, never silent."""
+    absent: tuple[str, ...] = field(default=())
+    """Signal fields the logger did not record (a braking log without load cells, or without
+    a flywheel encoder): NaN here, and what needs them skips the run and says so."""
 
     def __post_init__(self) -> None:
         n = np.shape(self.time_s)
@@ -51,7 +54,12 @@ class Run:
     def part(self, samples: slice, name: str) -> Run:
         """The samples ``samples`` of this run, as the run ``name``."""
         return Run(name=name, time_s=self.time_s[samples], source=self.source,
-                   notes=self.notes, **{s: getattr(self, s)[samples] for s in SIGNALS})
+                   notes=self.notes, absent=self.absent,
+                   **{s: getattr(self, s)[samples] for s in SIGNALS})
+
+    def lacks(self, *fields: str) -> tuple[str, ...]:
+        """Those of ``fields`` the logger did not record."""
+        return tuple(f for f in fields if f in self.absent)
 
     @property
     def rate_hz(self) -> float:

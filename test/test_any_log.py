@@ -3,15 +3,19 @@ datasheet naming what differs from the reference, one command to a verdict."""
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
 import pytest
 import yaml
 
+from antiskid.metrics import braking_metrics
 from landing_gear_sim.calibration.campaign import NOISE, generate_campaign, rig_like
 from landing_gear_sim.calibration.identify import identify
+from landing_gear_sim.cli import main
 from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, diagnose
+from landing_gear_sim.errors import LandingGearSimError
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model import scenario as sc
@@ -44,13 +48,56 @@ def test_a_log_of_time_current_and_pressure_reads_as_an_actuator_only_run(tmp_pa
     assert any("actuator-only" in note for note in run.notes)
 
 
-def test_a_braking_log_without_some_of_its_channels_is_refused_naming_them(tmp_path):
+def _without(source, target, *columns: str) -> None:
+    """``source``'s contract CSV less ``columns``, as a logger without them leaves it."""
+    rows = [line.split(",") for line in source.read_text().splitlines()]
+    keep = [i for i, name in enumerate(rows[0]) if name not in columns]
+    target.write_text("\n".join(",".join(row[i] for i in keep) for row in rows) + "\n")
+
+
+def test_a_braking_log_without_its_wheel_speed_is_refused_naming_it(tmp_path):
     (path,) = generate_campaign(tmp_path / "full", load_parameters(), 4, ["brake_const_10bar"])
-    lines = path.read_text().splitlines()
+    _without(path, tmp_path / "no_wheel.csv", "wheel_speed_rad_s")
+    with pytest.raises(RunFormatError, match=r"wheel_speed_rad_s"):
+        read_csv(tmp_path / "no_wheel.csv")
+
+
+def test_a_braking_log_without_load_cells_is_read_and_its_stop_measured(tmp_path, capsys):
+    """Issue 43: a brake-control engineer's anti-skid log has no load cells. It was refused
+    ("missing column(s) vertical_load_N, longitudinal_force_N"); now read, its stop measured
+    as the full log's, and what needs the loads (the friction used) said not logged."""
+    (path,) = generate_campaign(tmp_path / "full", load_parameters(), 5, ["brake_const_30bar"])
     cut = tmp_path / "no_loads.csv"
-    cut.write_text("\n".join(",".join(line.split(",")[:5]) for line in lines) + "\n")
-    with pytest.raises(RunFormatError, match=r"vertical_load_N.*longitudinal_force_N"):
-        read_csv(cut)
+    _without(path, cut, "vertical_load_N", "longitudinal_force_N")
+    run = read_csv(cut)
+    assert run.absent == ("vertical_load_n", "longitudinal_force_n")
+    assert any("not logged" in note for note in run.notes)
+    for name, source in (("full", path), ("cut", cut)):
+        assert main(["metrics", str(source), "--json", str(tmp_path / f"{name}.json")]) == 0
+    full, without = (json.loads((tmp_path / f"{n}.json").read_text()) for n in ("full", "cut"))
+    assert without["stopping_distance_m"] == pytest.approx(full["stopping_distance_m"],
+                                                           rel=0.01)
+    assert without["slip_rms"] == pytest.approx(full["slip_rms"], rel=0.05)
+    assert without["braking_efficiency"] is None and full["braking_efficiency"] > 0.3
+    write_csv(run, tmp_path / "again.csv")  # written as logged: no column of NaN
+    assert "vertical_load_N" not in (tmp_path / "again.csv").read_text().splitlines()[0]
+
+
+def test_a_braking_log_without_a_flywheel_encoder_is_read_and_left_out_saying_why(tmp_path):
+    rig = load_parameters()
+    paths = generate_campaign(tmp_path / "full", rig, 6, ["actuator_steps_sweep",
+                                                          "brake_const_20bar"])
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    for path in paths:
+        _without(path, logs / path.name, *(("flywheel_speed_rad_s",)
+                                           if path.stem.startswith("brake") else ()))
+    runs = read_campaign(logs).runs
+    with pytest.raises(LandingGearSimError, match="flywheel_speed_rad_s not logged"):
+        braking_metrics(next(r for r in runs if r.absent), rig)
+    result = diagnose(runs, rig)
+    assert any(p.startswith("brake_const_20bar: flywheel_speed_rad_s not logged: left out")
+               for p in result.problems), result.problems
 
 
 def test_a_slow_valves_step_log_and_its_datasheet_give_its_delay_in_one_command(tmp_path):

@@ -369,6 +369,8 @@ def test_every_number_in_the_pages_tables_is_the_one_in_the_json(delay_diagnosed
     # were 'gain_drift_per_run = -0.03475 ± 1.4e-05' (I09) and a load law read in kN
     ("gain_drift_per_run", -0.03475, 1.4e-5, "gain_drift = -3.475 ± 0.0014 %/run"),
     ("load_sensitivity_per_n", 1.022e-5, 2.9e-8, "load_sensitivity = 1.022 ± 0.0029 %/kN"),
+    # a discovered term's name, whole (U04's page had read '5 bar] = 148.3 ± 0.24')
+    ("[P > 0.5 bar]", 148.3, 0.24, "[P > 0.5 bar] = 148.3 ± 0.24"),
 ])
 def test_a_parameter_reads_in_engineering_units(key, value, std, text):
     assert parameter_text(key, value, std) == text

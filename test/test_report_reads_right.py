@@ -147,3 +147,28 @@ def test_figures_name_their_run_and_keep_their_legends_off_the_traces(reference,
     assert len(saved) == 3 and all(_legends_off_the_axes(fig) for fig in saved)
     assert all(run.name in fig.get_suptitle() for fig in saved[1:])
     assert diagnosis.psd_unit("rad/s") == "(rad/s)²/Hz" and diagnosis.psd_unit("Pa") == "Pa²/Hz"
+
+
+def test_the_local_gain_figure_keeps_its_keys_off_the_estimates(tmp_path, monkeypatch):
+    """The page's local brake-gain panels had their legends in the corner of the estimates,
+    and the bands of one pressure (a constant-pressure stop fills several) drawn joined by
+    lines that zig-zagged up and down at 10 bar."""
+    import numpy as np
+
+    from landing_gear_sim.diagnosis.local import VARIABLES, LocalGain
+    from landing_gear_sim.report import local
+
+    def gain(variable: str, run: str = "campaign") -> LocalGain:
+        centres = np.array([10.0, 10.0, 10.0, 19.0, 30.0])
+        return LocalGain(variable, VARIABLES.get(variable, "s"), run, centres,
+                         np.array([0.997, 1.0, 1.003, 1.0007, 1.0003]), np.full(5, 3e-4),
+                         0.001, 0.002)
+
+    saved = _figures_saved(monkeypatch, local)
+    local.plot_local_gains([gain(v) for v in VARIABLES] + [gain("time in run", "stop")],
+                           [gain(v) for v in VARIABLES], tmp_path / "l.png")
+    (fig,) = saved
+    assert _legends_off_the_axes(fig)
+    bands = [line for axis in fig.axes[:len(VARIABLES)] for line in axis.get_lines()
+             if len(line.get_xdata()) == 5]
+    assert bands and all(line.get_linestyle() == "None" for line in bands)

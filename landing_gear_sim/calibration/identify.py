@@ -31,7 +31,14 @@ from landing_gear_sim.calibration.actuator import (
 from landing_gear_sim.calibration.friction import KEYS as FRICTION_KEYS
 from landing_gear_sim.calibration.friction import fit_friction, refine_friction
 from landing_gear_sim.calibration.plausibility import check_units, unit_notes
-from landing_gear_sim.calibration.runs import ClassifiedRun, Family, RunKind, classify_all, select
+from landing_gear_sim.calibration.runs import (
+    ClassifiedRun,
+    Family,
+    RunKind,
+    classify_all,
+    fully_logged,
+    select,
+)
 from landing_gear_sim.calibration.statistics import Estimate
 from landing_gear_sim.errors import IdentificationError, ParameterError
 from landing_gear_sim.model.parameters import RigParameters
@@ -121,7 +128,8 @@ def identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool = False,
 def _identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool,
               progress: Progress | None, friction: bool, jackknife: bool) -> Identification:
     state = _Calibration(base, progress or (lambda _msg: None))
-    classified = classify_all(runs)
+    classified, left_out = fully_logged(classify_all(runs), "the calibration")
+    state.problems.extend(left_out)
     check_units(classified, base)
     state.problems.extend(unit_notes(classified, base))
     ramps = select(classified, [RunKind.ACTUATOR_RAMP])

@@ -25,7 +25,11 @@ from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.actuator import actuator_pressure
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.model.quantities import rim_speed_m_s, rolling_radius_at
+from landing_gear_sim.model.quantities import (
+    logged_or_set_load_n,
+    rim_speed_m_s,
+    rolling_radius_at,
+)
 from landing_gear_sim.model.scenario import BRAKE_ON_CURRENT_A
 from msg_tools.checks import CONTACT_LOAD_N, MIN_BRAKING_SAMPLES, TURNING_RAD_S
 from msg_tools.units import PA_PER_BAR, UNITS
@@ -152,7 +156,7 @@ LOAD_PERCENTILE = 95.0  # a stop's load near its static set point (lift takes fr
 def _load_ratio(run: ClassifiedRun, params: RigParameters) -> float | None:
     """A braking run's load near its set point over the rig's static load (None: not a
     braking run)."""
-    if not run.braking:
+    if not run.braking or run.lacks("vertical_load_n"):
         return None
     static = params.number(K.LOADING_STATIC_LOAD_N)
     return float(np.percentile(run.vertical_load_n, LOAD_PERCENTILE)) / static
@@ -184,11 +188,12 @@ def _other_load(runs: Sequence[ClassifiedRun], params: RigParameters) -> str | N
 
 
 def _check_speeds(run: ClassifiedRun, params: RigParameters) -> None:
-    rolling = ((run.time_s < run.brake_start_s) & (run.vertical_load_n > CONTACT_LOAD_N)
+    load = logged_or_set_load_n(run, params)  # a log without load cells: rpm named too
+    rolling = ((run.time_s < run.brake_start_s) & (load > CONTACT_LOAD_N)
                & (np.abs(run.flywheel_speed_rad_s) > TURNING_RAD_S))
     if not run.braking or rolling.sum() < MIN_BRAKING_SAMPLES:
         return
-    wheel = run.wheel_speed_rad_s[rolling] * rolling_radius_at(params, run.vertical_load_n[rolling])
+    wheel = run.wheel_speed_rad_s[rolling] * rolling_radius_at(params, load[rolling])
     ratio = float(np.median(wheel) / np.median(rim_speed_m_s(params, run.flywheel_speed_rad_s[
         rolling])))
     if PLAUSIBLE_RATIO[0] <= ratio <= PLAUSIBLE_RATIO[1]:

@@ -17,6 +17,7 @@ import enum
 import functools
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 
@@ -196,6 +197,17 @@ def classify_all(runs: Iterable[Run]) -> list[ClassifiedRun]:
     for rank, i in enumerate(braking):
         done[i] = dataclasses.replace(done[i], campaign_order=rank - middle)
     return done
+
+
+RunT = TypeVar("RunT", bound=Run)
+
+
+def fully_logged(runs: Sequence[RunT], analysis: str) -> tuple[list[RunT], list[str]]:
+    """The runs that logged every channel, and a note for each left out of ``analysis``
+    (a braking log without load cells or a flywheel encoder: its model needs them all)."""
+    kept = [r for r in runs if not r.absent]
+    return kept, [f"{r.name}: {', '.join(r.absent)} not logged: left out of {analysis}"
+                  for r in runs if r.absent]
 
 
 def select(runs: Sequence[ClassifiedRun], selectors: Iterable[Selector]) -> list[ClassifiedRun]:

@@ -46,6 +46,7 @@ from landing_gear_sim.calibration.wheel_angle import (
     checked_ripple,
 )
 from landing_gear_sim.diagnosis.equation_library import Campaign, equation_checks
+from landing_gear_sim.diagnosis.equations import DECLARED, declaring
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.load_relation import (
     LOAD_SPREAD,
@@ -138,14 +139,15 @@ def inconsistent(broken: Sequence[Check]) -> Finding:
     them): the strongest one's deviation, every one in the evidence, and the equation (or
     the channel's measurement) its relation checks."""
     best = broken[0]
-    equation, channel = best.relation.equation, best.relation.channel
+    equation = declaring(best.relation)
+    channel = DECLARED[equation].channel
     return Finding(cause="unexplained", parameters={"deviation": best.deviation},
                    std={"deviation": best.std},
                    evidence=f"measured relations the model cannot break are violated, in the "
                    f"{equation}: " + "; ".join(c.describe() for c in broken[:4])
                    + (f"; and {len(broken) - 4} more" if len(broken) > 4 else ""),
                    fit_before={}, fit_after={}, delta_bic=None, held_out=None, accepted=False,
-                   fitted_on=tuple(sorted({c.run for c in broken})), equation=equation,
+                   fitted_on=tuple(sorted({c.run for c in broken})), equation=str(equation),
                    channel=channel)
 
 

@@ -22,7 +22,7 @@ import numpy as np
 
 from landing_gear_sim.calibration.identify import Progress, identify
 from landing_gear_sim.calibration.measured import CHANNELS, simulate_all
-from landing_gear_sim.calibration.runs import ClassifiedRun, classify_all
+from landing_gear_sim.calibration.runs import ClassifiedRun, classify_all, fully_logged
 from landing_gear_sim.calibration.statistics import Estimate
 from landing_gear_sim.diagnosis import discovered
 from landing_gear_sim.diagnosis.catalogue import (
@@ -132,14 +132,16 @@ def diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str] = 
 def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
               progress: Progress | None) -> Diagnosis:
     say = progress or (lambda _msg: None)
+    kept, left_out = fully_logged(classify_all(runs), "the diagnosis")  # once: kinds read
+    runs = kept
     if not runs:
-        raise DiagnosisError("no run to diagnose")
-    runs = classify_all(runs)  # once: every step below reads the kinds
+        raise DiagnosisError("no run to diagnose" + (f" ({'; '.join(left_out)})"
+                                                      if left_out else ""))
     start = starting_model(base, without)
     say(f"calibrating the starting model on {len(runs)} runs")
     calibration = identify(runs, start, progress=say, friction=FRICTION_CURVE not in without,
                            jackknife=False)
-    problems = list(calibration.problems)
+    problems = [*left_out, *calibration.problems]
     calibrated = calibration.params
     simulated_before = simulate_all(runs, calibrated)
     baseline = baseline_fits(runs, simulated_before)

@@ -21,13 +21,15 @@ from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
 from landing_gear_sim.diagnosis import residuals as rs
 from landing_gear_sim.diagnosis.findings import Signature, SignatureKind
+from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.run import Run
 
 
 class Equation(str, enum.Enum):
-    """An equation of the rig's model (compares equal to its name)."""
+    """An equation of the rig's model, or a channel's measurement (compares equal to its
+    name); what each declares is in :data:`DECLARED`."""
 
     VALVE = "valve"
     WHEEL = "wheel"
@@ -35,6 +37,9 @@ class Equation(str, enum.Enum):
     FLYWHEEL = "flywheel"
     LOADING = "loading device"
     FX_CHANNEL = "F_x channel"
+    PRESSURE_CHANNEL = "pressure channel"
+    WHEEL_CHANNEL = "wheel channel"
+    LOAD_CELL = "load cell"
 
     def __str__(self) -> str:
         return self.value
@@ -42,12 +47,48 @@ class Equation(str, enum.Enum):
     @property
     def law(self) -> str:
         """The equation, in words."""
-        return {"valve": "P = A(s)·map(i) (valve pressure)",
-                "wheel": "J_w·ω̇ = r·F_x − T_b (wheel rotation)",
-                "tyre": "F_x = F_z·μ(λ) (tyre force)",
-                "flywheel": "m_f·v̇ = −F_x − F_drag (flywheel)",
-                "loading device": "F_z follows F_z0 − k_L·v² (loading device)",
-                "F_x channel": "F_x,read = F_x (the load cell's F_x channel)"}[self.value]
+        return DECLARED[self].law
+
+
+@dataclass(frozen=True)
+class Declared:
+    """What an equation declares: its law in words, the measured channel its error shows in,
+    and the relations the rig measures twice that check it."""
+
+    law: str
+    channel: str
+    relations: tuple[Relation, ...]
+
+
+DECLARED: dict[Equation, Declared] = {
+    Equation.VALVE: Declared("P = A(s)·map(i) (valve pressure)", "pressure_pa", (
+        Relation.VALVE_DIRECTION, Relation.VALVE_MAP, Relation.VALVE_DYNAMICS)),
+    Equation.WHEEL: Declared("J_w·ω̇ = r·F_x − T_b (wheel rotation)", "longitudinal_force_n", (
+        Relation.GAIN_IN_SPEED, Relation.GAIN_IN_PRESSURE, Relation.RUN_DRIFT,
+        Relation.FRICTION_IN_LOAD, Relation.BRAKE_ANGLE, Relation.WHEEL_BALANCE)),
+    Equation.TYRE: Declared("F_x = F_z·μ(λ) (tyre force)", "wheel_speed_rad_s",
+                            (Relation.TYRE_LAW,)),
+    Equation.FLYWHEEL: Declared("m_f·v̇ = −F_x − F_drag (flywheel)", "flywheel_speed_rad_s",
+                                (Relation.FLYWHEEL_BALANCE,)),
+    Equation.LOADING: Declared("F_z follows F_z0 − k_L·v² (loading device)", "vertical_load_n",
+                               (Relation.LOADING_LAW,)),
+    Equation.FX_CHANNEL: Declared("F_x,read = F_x (the load cell's F_x channel)",
+                                  "longitudinal_force_n",
+                                  (Relation.FREE_ROLLING, Relation.FX_CHANNEL)),
+    Equation.PRESSURE_CHANNEL: Declared("P_read = P (the pressure channel)", "pressure_pa",
+                                        (Relation.ZERO_CURRENT, Relation.PRESSURE_TIMING)),
+    Equation.WHEEL_CHANNEL: Declared("ω_read = ω (the wheel's encoder)", "wheel_speed_rad_s",
+                                     (Relation.WHEEL_ANGLE,)),
+    Equation.LOAD_CELL: Declared("F_z,read = F_z (the load cell)", "vertical_load_n",
+                                 (Relation.NO_CONTACT,)),
+}
+"""Each equation's law, channel and relations: one place to add a relation (a relation
+checks the one equation that declares it)."""
+
+
+def declaring(relation: Relation) -> Equation:
+    """The equation that declares ``relation`` (a violation of it lives there)."""
+    return next(e for e, declared in DECLARED.items() if relation in declared.relations)
 
 
 @dataclass(frozen=True)

@@ -22,6 +22,7 @@ from landing_gear_sim.calibration.slots import Slot
 from landing_gear_sim.diagnosis.equations import Equation
 from landing_gear_sim.diagnosis.relations import Check, Relation
 from landing_gear_sim.diagnosis.selection import (
+    MIN_EFFECT,
     Rows,
     Selected,
     Term,
@@ -58,6 +59,7 @@ class Library(abc.ABC, Generic[S]):
     phase: str
     sign: float = -1.0
     slot: Slot | None = None  # the generic slot its basis terms take places in
+    min_effect: float = MIN_EFFECT  # of the equation's scale: below it a term does not matter
 
     @abc.abstractmethod
     def sources(self, campaign: Campaign, params: RigParameters) -> list[S]:
@@ -77,7 +79,8 @@ class Library(abc.ABC, Generic[S]):
         """The library's terms the equation's error needs under ``params``."""
         rows = self._rows(campaign, params)
         fitted = fit_terms(self.terms, rows) if rows else None
-        return fitted.selected if fitted and significant(fitted, rows) else []
+        return fitted.selected if fitted and significant(fitted, rows, self.min_effect) \
+            else []
 
     def check(self, campaign: Campaign, params: RigParameters) -> Check | None:
         """The equation's relation over the campaign: what its terms explain jointly (None:
@@ -88,7 +91,7 @@ class Library(abc.ABC, Generic[S]):
             return None
         named = ", ".join(s.term.name for s in fitted.selected)
         return Check(self.relation, "campaign", f"{self.phase}, {named}", fitted.effect,
-                     fitted.effect / max(fitted.z, 1e-12), floor_of(rows),
+                     fitted.effect / max(fitted.z, 1e-12), floor_of(rows, self.min_effect),
                      self.unit)
 
     def _rows(self, campaign: Campaign, params: RigParameters) -> list[Rows]:

@@ -16,8 +16,8 @@ MIN_CHECK_S = 0.2  # ... or, where a log's rate matters, on less than this much 
 
 
 class Relation(str, enum.Enum):
-    """A relation the rig measures twice, by its display text (compares equal to it), with
-    the equation (or channel measurement) it checks and the channel that shows it."""
+    """A relation the rig measures twice, by its display text (compares equal to it); the
+    equation that declares it (``diagnosis.equations.DECLARED``) is the one it checks."""
 
     FREE_ROLLING = "free rolling ⇒ F_x = J_w ω̇ / r"
     ZERO_CURRENT = "zero current ⇒ zero pressure"
@@ -41,37 +41,7 @@ class Relation(str, enum.Enum):
     def __str__(self) -> str:
         return self.value
 
-    @property
-    def equation(self) -> str:
-        """The equation, or the channel's measurement, the relation checks."""
-        return _WHERE[self.name][0]
 
-    @property
-    def channel(self) -> str:
-        """The measured channel a violation shows in (the wheel's torque balance: F_x)."""
-        return _WHERE[self.name][1]
-
-
-_WHERE = {
-    "FREE_ROLLING": ("F_x channel", "longitudinal_force_n"),
-    "ZERO_CURRENT": ("pressure channel", "pressure_pa"),
-    "NO_CONTACT": ("load cell", "vertical_load_n"),
-    "GAIN_IN_SPEED": ("wheel", "longitudinal_force_n"),
-    "GAIN_IN_PRESSURE": ("wheel", "longitudinal_force_n"),
-    "RUN_DRIFT": ("wheel", "longitudinal_force_n"),
-    "VALVE_DIRECTION": ("valve", "pressure_pa"),
-    "FRICTION_IN_LOAD": ("wheel", "longitudinal_force_n"),
-    "WHEEL_ANGLE": ("wheel channel", "wheel_speed_rad_s"),
-    "PRESSURE_TIMING": ("pressure channel", "pressure_pa"),
-    "BRAKE_ANGLE": ("wheel", "longitudinal_force_n"),
-    "WHEEL_BALANCE": ("wheel", "longitudinal_force_n"),
-    "FLYWHEEL_BALANCE": ("flywheel", "flywheel_speed_rad_s"),
-    "LOADING_LAW": ("loading device", "vertical_load_n"),
-    "VALVE_MAP": ("valve", "pressure_pa"),
-    "TYRE_LAW": ("tyre", "wheel_speed_rad_s"),
-    "FX_CHANNEL": ("F_x channel", "longitudinal_force_n"),
-    "VALVE_DYNAMICS": ("valve", "pressure_pa"),
-}
 @dataclass(frozen=True)
 class Check:
     """One relation on one run (or the campaign) and phase: the deviation found, its 1-σ

@@ -208,18 +208,18 @@ def _strongest(x: np.ndarray, y: np.ndarray, owned: np.ndarray, columns: list[in
     return [columns[min(range(x.shape[1]), key=left)]] if x.shape[1] else []
 
 
-def significant(fitted: Fitted, rows: Sequence[Rows]) -> bool:
-    return fitted.z > Z_VIOLATED and fitted.effect > floor_of(rows) \
+def significant(fitted: Fitted, rows: Sequence[Rows], min_effect: float = MIN_EFFECT) -> bool:
+    return fitted.z > Z_VIOLATED and fitted.effect > floor_of(rows, min_effect) \
         and all(s.t > Z_VIOLATED for s in fitted.selected)
 
 
-def floor_of(rows: Sequence[Rows]) -> float:
-    """The effect below which a term does not matter: MIN_EFFECT of the equation's scale,
+def floor_of(rows: Sequence[Rows], min_effect: float = MIN_EFFECT) -> float:
+    """The effect below which a term does not matter: ``min_effect`` of the equation's scale,
     or NOISE_FLOOR times what the regressors' noise makes of the error (a counted wheel
     channel's slip, σ 0.03 at 64 lines, reads as a friction curve of another shape:
     errors in the variables)."""
     noise = float(np.sqrt(np.mean([r.noise ** 2 for r in rows])))
-    return max(MIN_EFFECT * scale_of(rows), NOISE_FLOOR * noise)
+    return max(min_effect * scale_of(rows), NOISE_FLOOR * noise)
 
 
 def scale_of(rows: Sequence[Rows]) -> float:

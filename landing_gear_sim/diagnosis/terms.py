@@ -88,6 +88,8 @@ def coefficient_unit(equation_unit: str, term: BasisTerm) -> str:
     if equation_unit in factors:  # P·ΔP in an equation in Pa: 1/Pa, not Pa/(Pa Pa)
         factors.remove(equation_unit)
         rest = " ".join(factors)
+        if not rest:  # sgn Ṗ·ΔP in an equation in Pa: a plain number
+            return "-"
         if "/" in rest and " " not in rest:
             numerator, denominator = rest.split("/")
             return f"{denominator}/{numerator}"

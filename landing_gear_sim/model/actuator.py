@@ -180,12 +180,18 @@ def settled_state(p, matrices, current_a):
     dead-band, where every run of the rig starts): where a run's simulation starts, so a
     part of a run cut in time starts where the valve was."""
     xa = actuator_state(matrices)
-    xa[0] = actuator_step(p, matrices, xa, current_a)
-    filled = xa.size  # the delay's register full first (the pressure rests until then)
-    for k in range(100000):
+    seen = current_a
+    if p[_BACKLASH] > 0.0:
+        seen = valve_play(p[_BACKLASH], 0.0, current_a)
+        xa[PLAY] = seen
+    # the delay's register full of the held level first: the settling is then the same
+    # arithmetic with a delay as without (a delay shifts a run's pressure exactly), and
+    # does not stop at once on a pressure resting until the delayed level arrives
+    xa[PLAY + 1:] = el.valve_static_pressure(p, seen)
+    for _ in range(100000):
         before = xa[0]
         actuator_step(p, matrices, xa, current_a)
-        if k >= filled and abs(xa[0] - before) < 1e-9 and abs(xa[1]) < 1e-6:
+        if abs(xa[0] - before) < 1e-9 and abs(xa[1]) < 1e-6:
             break
     return xa
 

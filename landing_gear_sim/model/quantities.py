@@ -14,6 +14,7 @@ import numpy as np
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
+from msg_tools.run import Run
 
 Value = TypeVar("Value", float, np.ndarray)
 """A float or an array: the same law serves a node's one sample and a run's arrays."""
@@ -96,3 +97,15 @@ def at_static_load(params: RigParameters, static_load_n: float,
     reference load stays where it was (a tyre's load sensitivity acts between the two)."""
     return params.replace({STATIC_LOAD: static_load_n,
                            REFERENCE_LOAD: reference_load_n(params)}, source)
+
+
+def logged_or_set_load_n(run: Run, params: RigParameters) -> np.ndarray:
+    """The run's vertical load [N], or where the logger had no load cell the loading
+    device's set point F_z0 − k_L·v² at the flywheel's speed (the static load alone left a
+    stop's slip rms 29 % off: the radius follows the load the lift takes off)."""
+    if "vertical_load_n" not in run.absent:
+        return run.vertical_load_n
+    static = np.full(len(run), params.number(K.LOADING_STATIC_LOAD_N))
+    if "flywheel_speed_rad_s" in run.absent:
+        return static
+    return static - el.load_lift(params.vector(), rim_speed_m_s(params, run.flywheel_speed_rad_s))

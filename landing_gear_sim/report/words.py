@@ -4,6 +4,8 @@ tables, for whoever checks the rule)."""
 
 from __future__ import annotations
 
+import re
+
 from landing_gear_sim.calibration.measured import CHANNELS
 from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
 from landing_gear_sim.diagnosis.findings import Finding
@@ -128,6 +130,8 @@ def parameter_text(key: str, value: float, std: float | None) -> str:
     """``name = value ± σ`` in the unit a brake engineer reads, e.g. 'delay = 5.99 ± 0.29 ms'
     for ``actuator_delay.delay_s`` (issue 32: 0.0059941 ± 0.00029 s), 'gain_drift = −3.475 ±
     0.0014 %/run' for ``gain_drift_per_run``."""
+    if not re.fullmatch(r"[\w.]+", key):  # a discovered term's name ('[P > 0.5 bar]'): whole
+        return f"{key} = {value:.4g}" + ("" if std is None else f" ± {std:.2g}")
     name, _, suffix = key.rsplit(".", 1)[-1].rpartition("_")
     unit = KEY_UNITS.get(suffix)
     if unit is not None and name.endswith("_per"):

@@ -212,13 +212,20 @@ def test_a_step_log_without_a_ramp_reads_the_valves_map_from_its_held_levels(tmp
     assert not any("static map" in p for p in calibration.problems), calibration.problems
 
 
-def test_a_run_that_starts_with_the_brake_applied_starts_where_the_valve_was():
-    """A run's simulation starts settled on its first current (a part of a run cut in time
-    starts mid-hold), also behind a transport delay (whose register had made the settling
-    stop at once, at zero)."""
+def test_a_part_cut_mid_hold_starts_where_the_valve_was_and_a_log_at_rest_at_rest():
+    """A part of a run cut in time starts mid-hold: its simulation had started at zero
+    pressure, 18 bar off, behind a delay whose register made the settling stop at once. A
+    sweep whose first sample commands a step starts at rest, as the rig did (U02's)."""
+    from landing_gear_sim.calibration.measured import simulate_run
+    from landing_gear_sim.calibration.runs import classified
+
     rig = load_parameters().replace({"elements.actuator_delay": True,
                                      K.ACTUATOR_DELAY_S: 0.08}, "a delay")
     level = 0.5 * rig.number(K.ACTUATOR_MAX_CURRENT_A)
-    result = simulate(rig, sc.actuator_test(rig, sc.constant(level), 1.0))
-    pressure = result.to_run().pressure_pa
-    assert pressure[0] == pytest.approx(pressure[-1], rel=1e-6) and pressure[0] > 1e5
+    logged = simulate(rig, sc.actuator_test(rig, sc.constant(level), 4.0)).to_run()
+    assert logged.pressure_pa[0] == 0.0 and logged.pressure_pa[-1] > 1e6
+    part = classified(logged.part(slice(2000, None), "held (after)"))
+    whole = classified(logged)
+    assert simulate_run(part, rig)[0].pressure_pa[0] == pytest.approx(part.pressure_pa[0],
+                                                                      rel=1e-6)
+    assert simulate_run(whole, rig)[0].pressure_pa[0] == 0.0

@@ -20,11 +20,8 @@ def test_whole_step_delay_shifts_the_pressure_exactly(reference):
     plain = _actuator_run(reference)
     delayed = _actuator_run(reference.replace({"elements.actuator_delay": True,
                                                "actuator.delay_s": 0.008}))
-    # both start settled on the profile's first level (0.2 A), where the run starts: the
-    # shift is exact to the settling's own rounding (1e-8 Pa of 7 bar)
-    np.testing.assert_allclose(delayed.pressure_pa[8:], plain.pressure_pa[:-8], rtol=0,
-                               atol=1e-6)
-    np.testing.assert_allclose(delayed.pressure_pa[:8], plain.pressure_pa[0], rtol=0, atol=1e-6)
+    assert np.array_equal(delayed.pressure_pa[8:], plain.pressure_pa[:-8])
+    assert np.all(delayed.pressure_pa[:8] == 0.0)
 
 
 def test_fractional_delay_is_exact_between_samples(reference):

@@ -23,7 +23,7 @@ from landing_gear_sim.calibration.wheel_angle import (
 )
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
-from landing_gear_sim.model.elements import load_lift
+from landing_gear_sim.model.elements import load_lift, valve_static_pressure
 from landing_gear_sim.model.integrate import SimulationResult, simulate
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import at_static_load, rim_speed_m_s
@@ -60,9 +60,24 @@ def scenario_for_run(run: ClassifiedRun, params: RigParameters,
     initial = float(np.mean(rim_speed_m_s(params, run.flywheel_speed_rad_s[
         :INITIAL_SPEED_SAMPLES])))
     contact = run.braking
-    return Scenario(run.name, logged_to_held(run.command_a), run.rate_hz, contact,
+    current = logged_to_held(run.command_a)
+    return Scenario(run.name, current, run.rate_hz, contact,
                     initial if contact else 0.0, LOWEST_SIM_SPEED_M_S if contact else 0.0,
-                    "measured input", wheel_angle_rad=wheel_angle_rad)
+                    "measured input", wheel_angle_rad=wheel_angle_rad,
+                    settled_start=starts_settled(run, params, float(current[0])))
+
+
+START_SAMPLES = 20  # the first samples that say whether a log starts at rest or mid-hold
+
+
+def starts_settled(run: Run, params: RigParameters, current_a: float) -> bool:
+    """Whether ``run``'s pressure starts nearer the map's pressure for its first current than
+    zero: a part of a run cut mid-hold does (started at rest its simulation was 18 bar off
+    there), a sweep whose first sample commands a step does not (the rig starts at rest)."""
+    static = float(valve_static_pressure(params.vector(), current_a))
+    first = float(SensorModel.of(params).true_pressure(
+        np.median(run.pressure_pa[:START_SAMPLES])))
+    return static > 0.0 and abs(first - static) < abs(first)
 
 
 GAIN = K.BRAKE_GAIN_N_M_PER_PA

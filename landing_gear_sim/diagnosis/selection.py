@@ -237,5 +237,7 @@ def ordinary_fit(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     coef, *_ = np.linalg.lstsq(scaled, y, rcond=None)
     residual = y - scaled @ coef
     variance = float(residual @ residual) / effective_count(residual)
-    std = np.sqrt(np.maximum(np.diag(np.linalg.pinv(scaled.T @ scaled)), 0.0) * variance)
+    # a variance rounding made negative is an unknown σ: no significance (it had been NaN)
+    diagonal = np.diag(np.linalg.pinv(scaled.T @ scaled))
+    std = np.where(diagonal > 0.0, np.sqrt(np.abs(diagonal) * variance), np.inf)
     return coef / spread, np.abs(coef) / np.maximum(std, 1e-300)

@@ -176,9 +176,8 @@ def settled_response(p, matrices, current):
 
 @njit(cache=True)
 def settled_state(p, matrices, current_a):
-    """The actuator state settled on ``current_a`` held (zero for a current below the
-    dead-band, where every run of the rig starts): where a run's simulation starts, so a
-    part of a run cut in time starts where the valve was."""
+    """The actuator state settled on ``current_a`` held: where a part of a run cut in time,
+    or a log that starts mid-hold, starts (zero for a current below the dead-band)."""
     xa = actuator_state(matrices)
     seen = current_a
     if p[_BACKLASH] > 0.0:

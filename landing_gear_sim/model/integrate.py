@@ -13,7 +13,12 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, prange
 
-from landing_gear_sim.model.actuator import actuator_matrices, actuator_step, settled_state
+from landing_gear_sim.model.actuator import (
+    actuator_matrices,
+    actuator_state,
+    actuator_step,
+    settled_state,
+)
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.plant import (
     CHANNELS,
@@ -34,13 +39,15 @@ STOP_REASONS = ("end of input", "stop speed reached")
 
 
 @njit(cache=True, nogil=True)  # runs simulate side by side on threads
-def run_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed, angle, out):
+def run_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed, angle, out,
+               settled=False):
     """Simulate one run; fill ``out`` (n, N_CHANNELS); return (rows written, stop code).
     ``angle``: the wheel's measured angle at each step (n,), which the plant's angle takes
-    at every exchange, or empty: the plant's own."""
+    at every exchange, or empty: the plant's own. ``settled``: the valve starts settled on
+    ``current[0]`` (else at rest, as a rig test starts)."""
     x = np.zeros(N_STATES)
     x[SPEED] = initial_speed if contact else 0.0
-    xa = settled_state(p, matrices, current[0])
+    xa = settled_state(p, matrices, current[0]) if settled else actuator_state(matrices)
     xl = np.zeros(1)
     work = np.zeros((5, N_STATES))
     pressure, load = xa[0], 0.0
@@ -67,22 +74,23 @@ def run_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed,
 
 
 @njit(cache=True)
-def actuator_kernel(p, matrices, current, out):
+def actuator_kernel(p, matrices, current, out, settled=False):
     """The pressure column ``run_kernel`` records, from the actuator alone (it does not
-    depend on the wheel): ``out[0]`` settled on ``current[0]``, ``out[k+1]`` after step k with
-    ``current[k]``."""
-    xa = settled_state(p, matrices, current[0])
+    depend on the wheel): ``out[0]`` at rest or ``settled`` on ``current[0]``, ``out[k+1]``
+    after step k with ``current[k]``."""
+    xa = settled_state(p, matrices, current[0]) if settled else actuator_state(matrices)
     out[0] = xa[0]
     for k in range(current.shape[0] - 1):
         out[k + 1] = actuator_step(p, matrices, xa, current[k])
 
 
 @njit(cache=True, parallel=True)
-def batch_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed, out, rows, stop):
+def batch_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed, out, rows, stop,
+                 settled=False):
     """``run_kernel`` over parameter sets ``p`` (m, N_PARAMS) in parallel; inputs (m, n)."""
     for i in prange(p.shape[0]):
         rows[i], stop[i] = run_kernel(p[i], matrices[i], current[i], step_s, contact,
-                                      initial_speed, stop_speed, np.zeros(0), out[i])
+                                      initial_speed, stop_speed, np.zeros(0), out[i], settled)
 
 
 @dataclass(frozen=True)
@@ -113,7 +121,7 @@ class SimulationResult:
         vector = self.params.vector()
         pressure = np.empty(self.scenario.current_a.size)
         actuator_kernel(vector, actuator_matrices(vector, self.scenario.step_s),
-                        self.scenario.current_a, pressure)
+                        self.scenario.current_a, pressure, self.scenario.settled_start)
         times = np.arange(pressure.size) * self.scenario.step_s
         return SensorModel.of(self.params).pressure_channel(times, pressure)
 
@@ -160,7 +168,8 @@ def simulate(params: RigParameters, scenario: Scenario) -> SimulationResult:
     angle = np.zeros(0) if scenario.wheel_angle_rad is None else scenario.wheel_angle_rad
     rows, stop = run_kernel(vector, actuator_matrices(vector, scenario.step_s),
                             scenario.current_a, scenario.step_s, scenario.contact,
-                            scenario.initial_speed_m_s, scenario.stop_speed_m_s, angle, out)
+                            scenario.initial_speed_m_s, scenario.stop_speed_m_s, angle, out,
+                            scenario.settled_start)
     return SimulationResult(scenario, params, out[:rows].copy(), STOP_REASONS[stop])
 
 
@@ -192,6 +201,7 @@ def _simulate_chunk(params: list[RigParameters], scenario: Scenario,
     rows = np.zeros(len(params), dtype=np.int64)
     stop = np.zeros(len(params), dtype=np.int64)
     batch_kernel(vectors, matrices, inputs, scenario.step_s, scenario.contact,
-                 scenario.initial_speed_m_s, scenario.stop_speed_m_s, out, rows, stop)
+                 scenario.initial_speed_m_s, scenario.stop_speed_m_s, out, rows, stop,
+                 scenario.settled_start)
     return [SimulationResult(scenario, p, out[i, : rows[i]].copy(), STOP_REASONS[stop[i]])
             for i, p in enumerate(params)]

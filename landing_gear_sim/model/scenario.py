@@ -52,6 +52,10 @@ class Scenario:
     stop_speed_m_s: float
     description: str = field(default="")
     wheel_angle_rad: np.ndarray | None = field(default=None, kw_only=True)
+    settled_start: bool = field(default=False, kw_only=True)
+    """The valve starts settled on the first current (a log that starts mid-hold, a part of
+    a run cut in time); by default at rest, as a rig test starts even when its first sample
+    commands a step (the example campaigns' sweeps)."""
 
     def __post_init__(self) -> None:
         current = np.asarray(self.current_a, dtype=float)

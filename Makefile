@@ -57,6 +57,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/montecarlo.py
 	$(BIN)/python bench/history.py
 	$(BIN)/python bench/stopping.py
+	$(BIN)/python bench/step_logs.py
 
 clean:
 	rm -rf $(VENV) out build install log .pytest_cache

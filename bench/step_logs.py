@@ -58,13 +58,7 @@ def hidden_valve(datasheet: RigParameters, rng: np.random.Generator
 def step_log(rig: RigParameters, cycles: int, seed: int, folder: Path) -> Path:
     """The three-column log of ``cycles`` applies and releases."""
     top = rig.number(K.ACTUATOR_MAX_CURRENT_A)
-
-    def profile(t: np.ndarray) -> np.ndarray:
-        current = np.zeros_like(t)
-        for k in range(cycles):
-            current[(t >= 2.0 + 6.0 * k) & (t < 5.0 + 6.0 * k)] = LEVELS[k % 3] * top
-        return current
-
+    profile = sc.applies_and_releases(tuple(LEVELS[k % 3] * top for k in range(cycles)))
     duration = 15.0 if cycles == 1 else 2.0 + 6.0 * cycles
     result = simulate(rig, sc.actuator_test(rig, profile, duration, "valve_step"))
     full = folder / "full.csv"

@@ -133,14 +133,8 @@ def _step_log(rig, folder, cycles: int, seed: int):
     """One three-column log of ``cycles`` applies and releases (held 3 s, 3 s apart) at
     levels the test picks, as a valve's step test on a bench is logged."""
     top = rig.number(K.ACTUATOR_MAX_CURRENT_A)
-    levels = (0.6, 0.35, 0.8)
-
-    def profile(t):
-        current = np.zeros_like(t)
-        for k in range(cycles):
-            current[(t >= 2.0 + 6.0 * k) & (t < 5.0 + 6.0 * k)] = levels[k % 3] * top
-        return current
-
+    profile = sc.applies_and_releases(tuple(top * (0.6, 0.35, 0.8)[k % 3]
+                                            for k in range(cycles)))
     duration = 15.0 if cycles == 1 else 2.0 + 6.0 * cycles
     result = simulate(rig, sc.actuator_test(rig, profile, duration, "valve_step"))
     folder.mkdir()

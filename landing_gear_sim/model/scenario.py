@@ -100,6 +100,22 @@ def quasi_static_ramp(peak_a: float = 1.0, duration_s: float = 20.0) -> Profile:
     return lambda t: peak_a * np.clip(1.0 - np.abs(t - half) / half, 0.0, 1.0)
 
 
+def applies_and_releases(levels_a: tuple[float, ...], hold_s: float = 3.0,
+                         apart_s: float = 3.0, first_s: float = 2.0) -> Profile:
+    """A valve's step test on a bench: from rest, each level applied for ``hold_s`` and
+    released for ``apart_s``, the first at ``first_s``."""
+    period = hold_s + apart_s
+
+    def profile(t: np.ndarray) -> np.ndarray:
+        current = np.zeros_like(t)
+        for k, level in enumerate(levels_a):
+            start = first_s + period * k
+            current[(t >= start) & (t < start + hold_s)] = level
+        return current
+
+    return profile
+
+
 def steps(levels_a: tuple[float, ...] = (0.2, 0.5, 0.8, 0.35), hold_s: float = 2.0) -> Profile:
     """A staircase of current steps, each held ``hold_s`` (paper Fig. 9 left)."""
     levels = np.asarray(levels_a, dtype=float)

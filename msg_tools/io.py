@@ -90,11 +90,18 @@ def _read_any(path: Path, mapping: Mapping | None, name: str | None) -> Run:
 
 @dataclass(frozen=True)
 class Campaign:
-    """The readable runs of a campaign folder, and one message per file that was not."""
+    """The readable runs of a campaign folder; ``problems``: one message per file that was
+    not read (also in ``skipped``) and what reading the others had to say."""
 
     folder: Path
     runs: tuple[Run, ...]
     problems: tuple[str, ...]
+    skipped: tuple[str, ...] = ()
+
+    def said(self) -> list[str]:
+        """Each problem as a user reads it: 'skipped: …' for a file not read, 'note: …' for
+        what reading a run said (an actuator-only log had read 'skipped' and was read)."""
+        return [f"{'skipped' if p in self.skipped else 'note'}: {p}" for p in self.problems]
 
 
 def campaign_sources(folder: Path, skipped: list[str] | None = None) -> list[Path]:
@@ -143,6 +150,7 @@ def read_campaign(folder: Path, mapping: Mapping | None = None,
     runs: list[Run] = []
     problems: list[str] = []
     sources = campaign_sources(folder, problems)
+    skipped = list(problems)
     for number, source in enumerate(sources, 1):
         if progress and len(sources) > 1:
             progress(f"reading {number}/{len(sources)}: {source.relative_to(folder)}")
@@ -150,13 +158,14 @@ def read_campaign(folder: Path, mapping: Mapping | None = None,
             parts, notes = _read_parts(source, mapping, _campaign_name(folder, source))
         except RunFormatError as exc:
             problems.append(str(exc))
+            skipped.append(str(exc))
             continue
         runs.extend(parts)
         problems.extend(notes)
     if not runs:
         raise RunFormatError(f"{folder}: no readable run" +
                              (f" ({'; '.join(problems)})" if problems else ""))
-    return Campaign(folder, tuple(runs), tuple(problems))
+    return Campaign(folder, tuple(runs), tuple(problems), tuple(skipped))
 
 
 def _read_parts(path: Path, mapping: Mapping | None, name: str | None = None
@@ -186,11 +195,13 @@ def read_runs(paths: Sequence[Path], mapping: Mapping | None = None) -> Campaign
     """
     runs: list[Run] = []
     problems: list[str] = []
+    skipped: list[str] = []
     for path in map(Path, paths):
         if path.is_dir() and not is_bag(path):
             campaign = read_campaign(path, mapping)
             runs.extend(campaign.runs)
             problems.extend(campaign.problems)
+            skipped.extend(campaign.skipped)
         else:
             parts, notes = _read_parts(path, mapping)
             runs.extend(parts)
@@ -199,7 +210,8 @@ def read_runs(paths: Sequence[Path], mapping: Mapping | None = None) -> Campaign
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:
         raise RunFormatError(f"run name {twice[0]!r} given twice; runs need distinct names")
-    return Campaign(Path(paths[0]) if paths else Path("."), tuple(runs), tuple(problems))
+    return Campaign(Path(paths[0]) if paths else Path("."), tuple(runs), tuple(problems),
+                    tuple(skipped))
 
 
 def resample(run: Run, rate_hz: float) -> Run:

@@ -223,3 +223,17 @@ def test_a_part_cut_mid_hold_starts_where_the_valve_was_and_a_log_at_rest_at_res
     assert simulate_run(part, rig)[0].pressure_pa[0] == pytest.approx(part.pressure_pa[0],
                                                                       rel=1e-6)
     assert simulate_run(whole, rig)[0].pressure_pa[0] == 0.0
+
+
+def test_what_reading_said_is_a_note_and_only_an_unread_file_is_skipped(tmp_path):
+    """The CLI printed 'skipped: … an actuator-only log, read with the wheel off the
+    flywheel' for a log it had read."""
+    (path,) = generate_campaign(tmp_path / "full", load_parameters(), 7, ["actuator_ramp"])
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    _three_columns(path, logs / "actuator_ramp.csv")
+    (logs / "broken.csv").write_text("time_s,current_ref_A\n0,1\n")
+    said = read_campaign(logs).said()
+    assert any(s.startswith("note: ") and "actuator-only" in s for s in said), said
+    assert any(s.startswith("skipped: ") and "broken.csv" in s for s in said), said
+    assert len(said) == 2

@@ -110,8 +110,8 @@ def cmd_identify(args: argparse.Namespace) -> int:
     check_outputs(files=[args.output])
 
     campaign = read_campaign(args.campaign, mapping_of(args))
-    for problem in campaign.problems:
-        progress(f"skipped: {problem}")
+    for line in campaign.said():
+        progress(line)
     started = time.perf_counter()
     result = identify(campaign.runs, params_of(args), args.fix_theta3, progress)
     for name, kind in result.classes.items():
@@ -157,8 +157,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
     check_outputs(folders=[args.report])
     campaign = read_campaign(args.campaign, mapping_of(args))
-    for problem in campaign.problems:
-        progress(f"skipped: {problem}")
+    for line in campaign.said():
+        progress(line)
     params = params_of(args)
     progress(f"simulating {len(campaign.runs)} runs with their measured inputs")
     validation = validate_campaign(campaign.runs, params)
@@ -212,8 +212,8 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     from msg_tools.io import read_runs
 
     campaign = read_runs(args.runs, mapping_of(args))
-    for problem in campaign.problems:
-        progress(f"skipped: {problem}")
+    for line in campaign.said():
+        progress(line)
     started = time.perf_counter()
     result = diagnose(campaign.runs, base, args.start_without,
                       lambda m: progress(f"[{time.perf_counter() - started:5.1f} s] {m}"))

@@ -237,3 +237,18 @@ def test_what_reading_said_is_a_note_and_only_an_unread_file_is_skipped(tmp_path
     assert any(s.startswith("note: ") and "actuator-only" in s for s in said), said
     assert any(s.startswith("skipped: ") and "broken.csv" in s for s in said), said
     assert len(said) == 2
+
+
+def test_a_single_stop_says_what_one_more_run_would_settle(tmp_path):
+    """Issue 43, a campaign of one run: a braking run is one piece, never cut in time, so
+    what it fits better cannot be checked; the note names the run one more like it would
+    settle (it had said 'too little held-out data for a verdict')."""
+    rig = rig_like(load_parameters(), np.random.default_rng(57)).replace(
+        {"elements.tire_relaxation": True,
+         K.TYRE_RELAXATION_LENGTH_M: float(np.random.default_rng(58).uniform(0.4, 0.8))},
+        "hidden effect")
+    generate_campaign(tmp_path, rig, 57, ["brake_const_30bar"])
+    result = diagnose(read_campaign(tmp_path).runs, load_parameters())
+    assert result.verdict == INCONCLUSIVE, result.verdict
+    assert any("tire_relaxation" in p and "one more run like brake_const_30bar would settle"
+               in p for p in result.problems), result.problems

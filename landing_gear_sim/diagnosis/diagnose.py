@@ -196,8 +196,9 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     findings = [s.finding for s in accepted]
     unchecked = _unchecked(table) if not accepted else []
     problems.extend(f"{f.cause} ({_in_words(f.parameters)}): fits the runs it was fitted on "
-                    f"better (ΔBIC {f.delta_bic:+.0f}) but no run is left to check it on: too "
-                    "little held-out data for a verdict" for f in unchecked)
+                    f"better (ΔBIC {f.delta_bic:+.0f}) but no run is left to check it on: one "
+                    f"more run like {(*f.fitted_on, 'those')[0]} would settle it"
+                    for f in unchecked)
     problems.extend(_unsettled_in_time(table) if not accepted else [])
     if accepted or not (skipped or unchecked):
         if after:

@@ -57,7 +57,8 @@ SETTLED_TIME_CONSTANTS = 5.0  # a hold is settled this many of A(s)'s 1/(ζ ω_n
 MIN_HELD_SAMPLES = 20  # a hold's settled part shorter than this is no level
 
 
-def held_levels(runs: Sequence[Run], p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
+def held_levels(runs: Sequence[ClassifiedRun], p: RigParameters
+                ) -> tuple[np.ndarray, np.ndarray]:
     """The settled samples of the runs' held commands: (current [A], pressure [Pa]). A
     hold's samples count from its later half, and from SETTLED_TIME_CONSTANTS of the
     datasheet's A(s) after its step (a slow valve's delay is in neither)."""
@@ -66,7 +67,7 @@ def held_levels(runs: Sequence[Run], p: RigParameters) -> tuple[np.ndarray, np.n
         * p.number(K.ACTUATOR_DAMPING_RATIO))
     currents, pressures = [], []
     for run in runs:
-        command = run.command_a if isinstance(run, ClassifiedRun) else run.current_a
+        command = run.command_a
         edges = np.concatenate([[0], np.flatnonzero(np.diff(command)) + 1, [command.size]])
         for first, end in itertools.pairwise(edges.tolist()):
             start = first + max(round(settle_s * run.rate_hz), (end - first) // 2)
@@ -78,7 +79,7 @@ def held_levels(runs: Sequence[Run], p: RigParameters) -> tuple[np.ndarray, np.n
     return np.concatenate(currents), np.concatenate(pressures)
 
 
-def fit_map_to_holds(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
+def fit_map_to_holds(runs: Sequence[ClassifiedRun], p: RigParameters) -> list[Estimate]:
     """k1 (and k2 where two levels above the dead-band tell them apart) from the settled
     pressures of held commands (:func:`held_levels`): a step log's map, where no ramp was
     run. The dead-band and the saturation stay the datasheet's (a few levels do not show

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .checks import BRAKING_PRESSURE_PA, CONTACT_LOAD_N
+from .checks import BRAKING_PRESSURE_PA, CONTACT_LOAD_N, TURNING_RAD_S
 from .run import SIGNALS, Run
 
 MAX_STAMP_NOISE = 0.3  # of a period: stamps within this of the fitted grid are on it
@@ -137,8 +137,7 @@ def _unusable(part: Run) -> str:
     if len(part) < 3 or part.time_s[-1] - part.time_s[0] < MIN_PART_S:
         return f"shorter than {MIN_PART_S:g} s"
     head = slice(0, 5)
-    if (np.median(part.vertical_load_n[head]) > CONTACT_LOAD_N
-            and np.median(part.pressure_pa[head]) > BRAKING_PRESSURE_PA):
+    if np.median(braking(part)[head]) > 0.5:
         return "it begins mid-stop, with the brake acting on the loaded wheel"
     return ""
 
@@ -154,13 +153,26 @@ def time_base_notes(run: Run) -> tuple[str, ...]:
     notes = [note] if (note := rate_change_note(run)) else []
     clock = fixed_rate_clock(run.time_s)
     if clock is not None:
-        braking = (run.pressure_pa > BRAKING_PRESSURE_PA) & (run.vertical_load_n > CONTACT_LOAD_N)
+        acting = braking(run)
         notes.extend(f"{run.name}: {gap_text(run.time_s, clock, int(k))} while braking: no "
                      "stop is measured across it (a campaign splits the run there and leaves "
                      "the part begun mid-stop out)"
                      for k in np.flatnonzero(clock.missing > bridgeable(clock))
-                     if braking[k - 1] and braking[k])
+                     if acting[k - 1] and acting[k])
     return tuple(notes)
+
+
+def braking(run: Run) -> np.ndarray:
+    """Where the brake acts on the loaded wheel (mask). Without a load cell the wheel's
+    contact shows as the flywheel (or, without its encoder, the wheel) turning: a NaN load
+    had read 'never loaded', and a gap in such a log's stop went unsaid."""
+    if "vertical_load_n" not in run.absent:
+        loaded = run.vertical_load_n > CONTACT_LOAD_N
+    else:
+        turning = (run.wheel_speed_rad_s if "flywheel_speed_rad_s" in run.absent
+                   else run.flywheel_speed_rad_s)
+        loaded = np.abs(turning) > TURNING_RAD_S
+    return (run.pressure_pa > BRAKING_PRESSURE_PA) & loaded
 
 
 def rate_change_note(run: Run) -> str | None:

@@ -23,7 +23,7 @@ from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import load_parameters
 from msg_tools.csv_io import read_csv, write_csv
 from msg_tools.errors import RunFormatError
-from msg_tools.io import read_campaign
+from msg_tools.io import read_campaign, read_run
 
 SLOW_VALVE = {"actuator": {"natural_frequency_hz": 3.0, "damping_ratio": 0.9,
                            "map_k1_pa_per_a": 1.5e6, "map_k2_pa_per_a2": 3e5,
@@ -81,6 +81,23 @@ def test_a_braking_log_without_load_cells_is_read_and_its_stop_measured(tmp_path
     assert without["braking_efficiency"] is None and full["braking_efficiency"] > 0.3
     write_csv(run, tmp_path / "again.csv")  # written as logged: no column of NaN
     assert "vertical_load_N" not in (tmp_path / "again.csv").read_text().splitlines()[0]
+
+
+def test_a_gap_while_braking_is_said_in_a_log_without_load_cells(tmp_path):
+    """A gap's 'while braking' was judged from the load cell: a log without one (its load
+    NaN) never braked, and a 2 s gap in its stop went unsaid."""
+    (path,) = generate_campaign(tmp_path / "full", load_parameters(), 7, ["brake_const_30bar"])
+    run = read_csv(path)
+    on = np.flatnonzero(run.current_a > 0.5 * run.current_a.max())
+    lost = round(2.0 * run.rate_hz)
+    rows = path.read_text().splitlines()
+    first = 1 + on[len(on) // 3]  # the header is row 0
+    (tmp_path / "gap.csv").write_text("\n".join(rows[:first] + rows[first + lost:]) + "\n")
+    _without(tmp_path / "gap.csv", tmp_path / "no_loads.csv", "vertical_load_N",
+             "longitudinal_force_N")
+    for name in ("gap", "no_loads"):
+        notes = read_run(tmp_path / f"{name}.csv").notes
+        assert any("2 s missing" in n and "while braking" in n for n in notes), (name, notes)
 
 
 def test_a_braking_log_without_a_flywheel_encoder_is_read_and_left_out_saying_why(tmp_path):

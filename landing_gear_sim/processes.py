@@ -8,10 +8,10 @@ import ctypes
 import multiprocessing
 import os
 import signal
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
-from contextlib import AbstractContextManager
-from typing import TypeVar
+from contextlib import AbstractContextManager, contextmanager
+from typing import Any, TypeVar
 
 Item = TypeVar("Item")
 Result = TypeVar("Result")
@@ -26,28 +26,61 @@ def die_with_parent() -> None:
     libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
-def pool_worker() -> None:
+def pool_worker(busy: Counter | None = None) -> None:
     """Initializer of a worker-pool process: dies with its parent, leaves Ctrl-C to it (the
     parent stops the pool), and ends on SIGTERM at once (without the parent's handlers,
-    which a forked child inherits and which would print a traceback)."""
-    global _THREADS
+    which a forked child inherits and which would print a traceback). ``busy``: the pool's
+    count of tasks at work (:func:`working`), from which a task takes the cores the others
+    leave (without it, one thread: the pool already has a process per core)."""
+    global _THREADS, _BUSY
     die_with_parent()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    _THREADS = 1  # the pool already has a process per core
+    _THREADS, _BUSY = 1, busy
 
 
+Counter = Any  # a multiprocessing.Value("i"): its type is not importable
 _THREADS = os.cpu_count() or 1
+_BUSY: Counter | None = None
+
+
+def busy_counter() -> Counter:
+    """A count of a pool's tasks at work, shared with its (forked) workers."""
+    return multiprocessing.get_context("fork").Value("i", 0)
+
+
+@contextmanager
+def working() -> Iterator[None]:
+    """A pool task at work while inside: the last task of a pool takes every core (a
+    diagnosis' longest fit had run on one core while the other idled)."""
+    if _BUSY is None:
+        yield
+        return
+    with _BUSY.get_lock():
+        _BUSY.value += 1
+    try:
+        yield
+    finally:
+        with _BUSY.get_lock():
+            _BUSY.value -= 1
+
+
+def threads() -> int:
+    """Threads a compiled simulation may use now: a core each, or in a pool's worker the
+    cores its other tasks at work leave."""
+    if _BUSY is None:
+        return _THREADS
+    return max(1, (os.cpu_count() or 1) - max(int(_BUSY.value), 1) + 1)
 
 
 def map_threads(function: Callable[[Item], Result], items: Iterable[Item]) -> Sequence[Result]:
     """``function`` of each item, in order, on a thread per core: for work that releases the
-    GIL (the compiled simulation). One thread in a pool's worker, whose pool has a process
-    per core already (a Dask worker is a daemonic process)."""
-    work = list(items)
-    if _THREADS < 2 or len(work) < 2 or multiprocessing.current_process().daemon:
+    GIL (the compiled simulation). In a pool's worker, on the cores its other tasks leave
+    (:func:`threads`); in a daemonic process (a Dask worker's), one thread."""
+    work, cores = list(items), threads()
+    if cores < 2 or len(work) < 2 or multiprocessing.current_process().daemon:
         return [function(item) for item in work]
-    with ThreadPoolExecutor(min(_THREADS, len(work))) as pool:
+    with ThreadPoolExecutor(min(cores, len(work))) as pool:
         return list(pool.map(function, work))
 
 

@@ -64,3 +64,81 @@ def test_the_right_candidate_explains_more_than_a_wrong_one(reference, tmp_path)
     right = fit_candidate(CATALOGUE["actuator_delay"], runs, calibrated)
     wrong = fit_candidate(CATALOGUE["pressure_sensor_offset"], runs, calibrated)
     assert right.cost < 0.5 * wrong.cost
+
+
+def test_a_fits_jacobian_is_scipys_forward_difference_on_the_unit_box():
+    """The fits' Jacobian simulates its columns side by side; it must be the one scipy's
+    '2-point' differences gave (relative steps, backward at the box's edge), to the bit and
+    in its layout: the solver's rounding follows it, and a 1-ulp step once moved a fade's
+    fit to another optimum."""
+    from scipy.optimize._numdiff import approx_derivative
+
+    from landing_gear_sim.diagnosis.objective import DIFF_STEP, Objective
+
+    matrix = np.random.default_rng(3).normal(size=(9, 4))
+    calls: list[int] = []
+
+    def values(u):
+        return np.sin(matrix @ u) + np.sum(u) ** 2
+
+    def residuals(points):
+        calls.append(len(points))
+        return [values(u) for u in points]
+
+    objective = Objective(residuals)
+    for u in (np.array([0.2, 0.5, 0.7, 0.9]), np.array([0.0, 1.0, 1e-6, 1.0 - 1e-6])):
+        objective.fun(u)
+        ours = objective.jac(u)
+        theirs = approx_derivative(values, u, method="2-point", rel_step=DIFF_STEP,
+                                   bounds=(0.0, 1.0))
+        assert np.array_equal(ours, theirs)
+        assert ours.flags.f_contiguous == theirs.flags.f_contiguous
+    assert calls == [1, 4, 1, 4]  # the columns in one call; the point's residual reused
+
+
+def test_candidates_that_refit_the_same_base_parameters_share_one_null_fit(reference,
+                                                                          tmp_path,
+                                                                          monkeypatch):
+    """A family's proposals differ in their terms' codes, not in their null (those terms at
+    0): each had fitted the same null again."""
+    from dataclasses import replace
+
+    from landing_gear_sim.diagnosis import scoring
+    from landing_gear_sim.diagnosis.catalogue import CandidateFit
+    from landing_gear_sim.model import keys as K
+
+    runs, _ = _hidden(reference, tmp_path, 31, lambda rng: {}, ("brake_const_20bar",))
+    fits: list[str] = []
+
+    def fit(candidate, runs, model, *args, **kwargs):
+        fits.append(candidate.cause)
+        return CandidateFit(candidate, model, {}, {}, np.zeros(1))
+
+    monkeypatch.setattr(scoring, "fit_candidate", fit)
+    candidate = replace(CATALOGUE["tire_relaxation"], keys=())
+    code, coefficient = K.WHEEL_TERMS[0]
+    scales = {(r.name, c): 1.0 for r in runs for c in candidate.channels}
+    for value in (17.0, 33.0):
+        null = scoring._null_fit(candidate, runs, reference.replace({code: value}), reference,
+                                 scales)
+        assert null.params.number(code) == value  # the model's own codes, not the first's
+    assert fits == ["tire_relaxation"]
+    acting = reference.replace({code: 17.0, coefficient: 3.0})
+    scoring._null_fit(candidate, runs, acting, reference, scales)
+    assert len(fits) == 2
+
+
+def test_a_pool_task_takes_the_cores_the_pools_other_tasks_leave(monkeypatch):
+    """The diagnosis scores its candidates in a process per core; its longest fit had run
+    on one core while the other idled once the rest were scored."""
+    from landing_gear_sim import processes
+
+    monkeypatch.setattr(processes.os, "cpu_count", lambda: 2)
+    monkeypatch.setattr(processes, "_BUSY", processes.busy_counter())
+    with processes.working():
+        with processes.working():  # another task at work: a core each
+            assert processes.threads() == 1
+        assert processes.threads() == 2  # alone
+    monkeypatch.setattr(processes, "_BUSY", None)
+    monkeypatch.setattr(processes, "_THREADS", 1)
+    assert processes.threads() == 1  # a worker of a pool that shares no count

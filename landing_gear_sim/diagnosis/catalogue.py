@@ -28,6 +28,12 @@ from landing_gear_sim.calibration.runs import (
     select,
 )
 from landing_gear_sim.calibration.statistics import covariance_std
+from landing_gear_sim.diagnosis.objective import (
+    Objective,
+    Scales,
+    scaled_error,
+    scaled_residuals,
+)
 from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
@@ -35,7 +41,6 @@ from landing_gear_sim.model.quantities import gear_walk_modes
 from msg_tools.run import Run
 from msg_tools.units import PA_PER_BAR
 
-DECIMATE = 2  # residual samples kept (the simulation itself runs at the full rate)
 START_RATIO = 2.0  # multi-start: optimise only starts this close to the best initial cost
 PROBE_ITERATIONS = 3  # multi-start: each start gets this many steps, then only the best goes on
 MAX_ITERATIONS = 40  # the budget of one optimisation (each step simulates the runs 1 + n times)
@@ -201,9 +206,6 @@ class CandidateFit:
         return float(self.residual @ self.residual)
 
 
-Scales = dict[tuple[str, str], float]
-
-
 def noise_std(values: np.ndarray) -> float:
     """Sensor-noise std of a 1 kHz channel: first differences are noise-dominated."""
     return float(np.std(np.diff(values)) / math.sqrt(2)) or 1.0
@@ -212,14 +214,6 @@ def noise_std(values: np.ndarray) -> float:
 def noise_scales(runs: Sequence[Run], channels: Sequence[str]) -> Scales:
     """Noise std of every (run, channel), estimated from the measurement itself."""
     return {(r.name, c): noise_std(getattr(r, c)) for r in runs for c in channels}
-
-
-def scaled_error(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequence[str],
-                 scales: Scales) -> np.ndarray:
-    """Simulation minus measurement over ``channels``, divided by the noise, decimated."""
-    return np.concatenate([(getattr(sim, c) - getattr(run, c))[::DECIMATE]
-                           / scales[(run.name, c)]
-                           for run, sim in zip(runs, simulated, strict=True) for c in channels])
 
 
 def scaled_residual(runs: Sequence[Run], params: RigParameters, channels: Sequence[str],
@@ -273,17 +267,18 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
                      + [2.0 * max(r.number(k) for r in references) for k in free])
     window = _Window(lower, upper)
 
-    def residual(u: np.ndarray) -> np.ndarray:
-        trial = model.replace(dict(zip(keys, window.value(u), strict=True)), "fit")
-        return scaled_residual(chosen, trial, candidate.channels, scales)
+    def residuals(points: Sequence[np.ndarray]) -> list[np.ndarray]:
+        trials = [model.replace(dict(zip(keys, window.value(u), strict=True)), "fit")
+                  for u in points]
+        return scaled_residuals(chosen, trials, candidate.channels, scales)
 
     own_starts = candidate.starts if own and candidate.starts else [()]
     points = [window.unit(np.array([*(s or [r.number(k) for k in own]),
                                     *(r.number(k) for k in free)]))
               for s in own_starts for r in references]
     # a start the model does not survive (an unstable valve: inf or nan) is no start
-    initial = [cost if math.isfinite(cost := float(np.sum(residual(u) ** 2))) else math.inf
-               for u in points]
+    initial = [cost if math.isfinite(cost := float(np.sum(r ** 2))) else math.inf
+               for r in residuals(points)]
     if not math.isfinite(min(initial)):
         raise IdentificationError(f"{candidate.cause}: the model diverges from every start")
     order = [i for i in np.argsort(initial)[:tries] if initial[i] <= START_RATIO * min(initial)]
@@ -291,9 +286,10 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
     if len(order) > 1:
         # successive halving: the starts' first steps tell the basins apart; running each
         # to the end cost twice the time and always ended on the same optimum
-        probes = [_optimise(residual, points[i], PROBE_ITERATIONS) for i in order]
+        probes = [_optimise(Objective(residuals), points[i], PROBE_ITERATIONS)
+                  for i in order]
         start = min(probes, key=lambda fit: fit.cost).x
-    best = _optimise(residual, start, MAX_ITERATIONS)
+    best = _optimise(Objective(residuals), start, MAX_ITERATIONS)
     values = window.value(best.x)
     std = covariance_std(best, len(keys)) * window.slope(best.x)
     if K.ACTUATOR_DELAY_S in keys:
@@ -304,11 +300,10 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
                         dict(zip(keys, map(float, std), strict=True)), best.fun)
 
 
-def _optimise(residual: Callable[[np.ndarray], np.ndarray], start: np.ndarray,
-              iterations: int) -> OptimizeResult:
+def _optimise(objective: Objective, start: np.ndarray, iterations: int) -> OptimizeResult:
     """Least squares on the unit box from ``start``, at most ``iterations`` steps."""
-    return least_squares(residual, start, bounds=(0.0, 1.0), x_scale=0.01, diff_step=1e-4,
-                         ftol=FTOL, max_nfev=iterations)
+    return least_squares(objective.fun, start, jac=objective.jac, bounds=(0.0, 1.0),
+                         x_scale=0.01, ftol=FTOL, max_nfev=iterations)
 
 
 def input_timing_std_s(runs: Sequence[Run]) -> float:

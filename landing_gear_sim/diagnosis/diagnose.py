@@ -65,7 +65,7 @@ from landing_gear_sim.diagnosis.start import FRICTION_CURVE, starting_model
 from landing_gear_sim.errors import DiagnosisError, IdentificationError
 from landing_gear_sim.model.datasheet import datasheet_values
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.processes import pool_worker, single_threaded_blas
+from landing_gear_sim.processes import busy_counter, pool_worker, single_threaded_blas, working
 from msg_tools.run import Run
 
 MAX_ROUNDS = 4
@@ -289,7 +289,8 @@ def _score_one(candidate: Candidate, runs: Sequence[ClassifiedRun], model: RigPa
                datasheet: RigParameters, scales: Scales,
                signatures: Sequence[Signature]) -> Scored | str:
     try:
-        return score_candidate(candidate, runs, model, datasheet, scales, signatures)
+        with working():
+            return score_candidate(candidate, runs, model, datasheet, scales, signatures)
     except IdentificationError as exc:
         return f"{candidate.cause}: not scored ({exc})"
 
@@ -305,7 +306,8 @@ def _score_all(pending: Sequence[Candidate], runs: Sequence[ClassifiedRun], mode
         return [_score_one(c, runs, model, datasheet, scales, signatures) for c in pending]
     # fork: the children inherit the compiled physics instead of compiling it again
     context = multiprocessing.get_context("fork")
-    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=pool_worker)
+    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=pool_worker,
+                               initargs=(busy_counter(),))
     try:
         # the costliest first (more fitted parameters: more simulations per step), so the
         # last to finish is a short one

@@ -18,11 +18,11 @@ from dataclasses import dataclass, replace
 from landing_gear_sim.calibration.identify import Progress
 from landing_gear_sim.calibration.measured import CHANNELS, channels_of, simulate_all
 from landing_gear_sim.calibration.runs import ClassifiedRun
-from landing_gear_sim.diagnosis.catalogue import Scales, scaled_error
 from landing_gear_sim.diagnosis.consistency import check_campaign
 from landing_gear_sim.diagnosis.families import REGISTRY, Evidence, Family, Proposal
 from landing_gear_sim.diagnosis.families.wheel_skew import wheel_lags
 from landing_gear_sim.diagnosis.findings import Finding, Signature
+from landing_gear_sim.diagnosis.objective import Scales, scaled_error
 from landing_gear_sim.diagnosis.relations import Check, violations
 from landing_gear_sim.diagnosis.scoring import (
     HELD_OUT_THRESHOLD,

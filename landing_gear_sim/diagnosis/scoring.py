@@ -11,6 +11,8 @@ filtered out: see :func:`worth`), with no key parameter at the edge of its range
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
@@ -30,14 +32,13 @@ from landing_gear_sim.calibration.statistics import lag_one_correlation
 from landing_gear_sim.diagnosis.catalogue import (
     Candidate,
     CandidateFit,
-    Scales,
     fit_candidate,
     key_parameters,
-    scaled_error,
 )
 from landing_gear_sim.diagnosis.findings import Finding, Signature
+from landing_gear_sim.diagnosis.objective import Scales, scaled_error
 from landing_gear_sim.model.parameters import RigParameters
-from msg_tools.run import Run
+from msg_tools.run import SIGNALS, Run
 
 BIC_THRESHOLD = -10.0  # "very strong" evidence (Kass & Raftery 1995)
 HELD_OUT_THRESHOLD = -10.0
@@ -213,7 +214,7 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
         model = model.replace(dict(candidate.settings), f"{candidate.family}'s terms")
         start = start and start.replace(dict(candidate.settings), f"{candidate.family}'s terms")
     with_it = fit_candidate(sub, fit_runs, start or model, datasheet, scales=scales)
-    without = fit_candidate(sub, fit_runs, model, datasheet, null=True, scales=scales)
+    without = _null_fit(sub, fit_runs, model, datasheet, scales)
     if candidate.neutral and with_it.cost > without.cost:
         with_it = _from_null(sub, fit_runs, without, scales)
     k = len(candidate.keys)
@@ -239,6 +240,52 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
                       accepted=accepted, fitted_on=_names(fit_runs),
                       checked_on=_names(held_runs), family=candidate.family, reason=reason)
     return Scored(finding, with_it)
+
+
+_NULLS: dict[str, CandidateFit] = {}
+NULLS_KEPT = 32
+
+
+def _null_fit(candidate: Candidate, runs: Sequence[Run], model: RigParameters,
+              datasheet: RigParameters, scales: Scales) -> CandidateFit:
+    """``candidate``'s null fitted on ``runs``, once: candidates that re-fit the same base
+    parameters on the same runs share it (a family's proposals, each of a discovery's
+    ranks: 4 s of a 37 s diagnosis re-fitted the same null)."""
+    key = _null_key(candidate, runs, model, datasheet, scales)
+    if key not in _NULLS:
+        if len(_NULLS) >= NULLS_KEPT:
+            _NULLS.pop(next(iter(_NULLS)))
+        _NULLS[key] = fit_candidate(candidate, runs, model, datasheet, null=True,
+                                    scales=scales)
+    fit = _NULLS[key]
+    # the model's own slot codes (no term acts through them in a null)
+    return replace(fit, candidate=candidate,
+                   params=model.replace(fit.values, f"fit {candidate.cause}"))
+
+
+def _null_key(candidate: Candidate, runs: Sequence[Run], model: RigParameters,
+              datasheet: RigParameters, scales: Scales) -> str:
+    """What a null fit depends on, hashed: the parameters it frees, the channels and runs
+    it fits (their data), the model it starts from and the datasheet bounding it."""
+    digest = hashlib.blake2b(digest_size=20)
+    free = [k for k in candidate.free if k not in candidate.keys]
+    names = {r.name for r in runs}
+    digest.update(json.dumps([free, list(candidate.channels), [str(f) for f in candidate.runs],
+                              _acting(model), _acting(datasheet),
+                              sorted((f"{n}/{c}", v) for (n, c), v in scales.items()
+                                     if n in names)], default=str).encode())
+    for run in runs:
+        digest.update(run.name.encode())
+        for name in ("time_s", *SIGNALS):
+            digest.update(np.ascontiguousarray(getattr(run, name)).tobytes())
+    return digest.hexdigest()
+
+
+def _acting(params: RigParameters) -> dict[str, object]:
+    """``params``' values less the codes of slot terms whose coefficient is 0: no term
+    (a family's proposals set their terms' codes, and their nulls are one fit)."""
+    return {k: v for k, v in params.values.items()
+            if not (k.endswith("_code") and params.values.get(f"{k[:-5]}_coeff", 1.0) == 0.0)}
 
 
 ACCEPTED = "meets every rule (ΔBIC, held-out gain, parameters within range)"

@@ -269,3 +269,42 @@ def test_a_single_stop_says_what_one_more_run_would_settle(tmp_path):
     assert result.verdict == INCONCLUSIVE, result.verdict
     assert any("tire_relaxation" in p and "one more run like brake_const_30bar would settle"
                in p for p in result.problems), result.problems
+
+
+def _slow_valve_with_delay(datasheet, seed: int):
+    """A valve like the slow datasheet's (±5 % on ω_n and ζ) with a delay of 50-150 ms,
+    each drawn here."""
+    rng = np.random.default_rng(seed)
+    truth = {K.ACTUATOR_NATURAL_FREQUENCY_HZ: datasheet.number(
+                 K.ACTUATOR_NATURAL_FREQUENCY_HZ) * rng.uniform(0.95, 1.05),
+             K.ACTUATOR_DAMPING_RATIO: datasheet.number(K.ACTUATOR_DAMPING_RATIO)
+             * rng.uniform(0.95, 1.05),
+             K.ACTUATOR_DELAY_S: rng.uniform(0.05, 0.15)}
+    rig = datasheet.replace({**NOISE, "elements.actuator_delay": True, **truth}, "the valve")
+    return rig, truth
+
+
+def test_identify_fits_the_delay_a_datasheet_says_the_valve_has(tmp_path):
+    """Issue 43: identify fitted ω_n and ζ of a step log with the delay held where the
+    datasheet put it (or left out): a 4x slower valve's ω_n read 1.98 Hz for 2.98."""
+    rig, truth = _slow_valve_with_delay(_slow_datasheet(tmp_path), 54)
+    datasheet = _slow_datasheet(tmp_path).replace(
+        {"elements.actuator_delay": True, K.ACTUATOR_DELAY_S: 0.02}, "datasheet: a delay")
+    calibration = identify(read_campaign(_step_log(rig, tmp_path / "logs", 3, 54)).runs,
+                           datasheet, friction=False, jackknife=False)
+    for key, value in truth.items():
+        assert calibration.params.number(key) == pytest.approx(value, rel=0.1), key
+    assert any(e.key == K.ACTUATOR_DELAY_S for e in calibration.estimates)
+
+
+def test_identify_says_a_delay_the_model_lacks_and_what_it_costs_the_valves_dynamics(
+        tmp_path):
+    """Without a delay in the model, ω_n and ζ absorb the valve's dead time; identify says
+    how late the valve answers and where a delay is tested."""
+    rig, truth = _slow_valve_with_delay(_slow_datasheet(tmp_path), 55)
+    calibration = identify(read_campaign(_step_log(rig, tmp_path / "logs", 3, 55)).runs,
+                           _slow_datasheet(tmp_path), friction=False, jackknife=False)
+    (note,) = [p for p in calibration.problems if "later than A(s)" in p]
+    late_ms = float(note.split(" ms later than A(s)")[0].split()[-1])
+    assert late_ms == pytest.approx(1e3 * truth[K.ACTUATOR_DELAY_S], rel=0.15), note
+    assert "actuator_delay" in note and "diagnose" in note

@@ -50,7 +50,8 @@ def test_replaying_a_recorded_current_reproduces_the_run(tmp_path):
     a, b = read_csv(first), read_csv(second)
     n = min(len(a), len(b))
     assert abs(len(a) - len(b)) <= 1
-    assert (abs(a.wheel_speed_rad_s[:n] - b.wheel_speed_rad_s[:n])).max() < 1e-9
+    # the CSV's digits of the current are all the replay may lose: 1e-8 of 200 rad/s
+    assert (abs(a.wheel_speed_rad_s[:n] - b.wheel_speed_rad_s[:n])).max() < 1e-8
 
 
 @pytest.mark.parametrize(("argv", "fragment"), [

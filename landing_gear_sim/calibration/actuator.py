@@ -6,15 +6,15 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.signal
-from scipy.optimize import least_squares
+from scipy.optimize import OptimizeResult, least_squares
 
 from landing_gear_sim.calibration.runs import ClassifiedRun
-from landing_gear_sim.calibration.statistics import Estimate, covariance_std
+from landing_gear_sim.calibration.statistics import Estimate, covariance_std, input_timing_std_s
 from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
@@ -139,43 +139,96 @@ def actuator_frf(run: Run, params: RigParameters) -> FrfEstimate:
 
 
 def fit_actuator_dynamics(runs: Sequence[Run], p: RigParameters
-                          ) -> tuple[list[Estimate], FrfEstimate]:
-    """ω_n and ξ of A(s): FRF fit for a start, then output error on the measured pressure."""
+                          ) -> tuple[list[Estimate], FrfEstimate, list[str]]:
+    """ω_n and ξ of A(s), and its transport delay when ``p`` has one: an FRF fit and a
+    search of the dead time for a start, then output error on the measured pressure. A
+    model without a delay gets a note when the valve answers clearly later than A(s) can
+    (its ω_n and ζ absorb it: a 4x slower valve's 2.98 Hz read 1.98 Hz)."""
     run = max(runs, key=len)
-    frf = actuator_frf(run, p)
+    f_frf, zeta_frf = _frf_fit(actuator_frf(run, p), p)
+    residual = _time_residual(run, p if p.has("actuator_delay") else p.replace(
+        {"elements.actuator_delay": True, K.ACTUATOR_DELAY_S: 0.0}, "a delay tried"))
+    wn = 2 * math.pi * f_frf
+    delayed = least_squares(residual, [wn, zeta_frf, _dead_time_s(residual, wn, zeta_frf)],
+                            x_scale=[wn, 0.1, DELAY_SCALE_S],
+                            bounds=([1.0, 0.05, 0.0], [2000.0, 3.0, MAX_DELAY_S]))
+    notes: list[str] = []
+    keys: tuple[str, ...]
+    if p.has("actuator_delay"):
+        fit, keys = delayed, DYNAMICS_KEYS
+    else:
+        fit = least_squares(lambda theta: residual([*theta, 0.0]), [wn, zeta_frf],
+                            x_scale=[wn, 0.1], bounds=([1.0, 0.05], [2000.0, 3.0]))
+        keys = DYNAMICS_KEYS[:2]
+        notes = _late_note(fit.cost, delayed, run.rate_hz)
+    std = covariance_std(fit, len(keys))
+    if len(keys) == 3:  # a delay is known no better than when the logger saw the steps
+        std[2] = math.hypot(std[2], input_timing_std_s([run]))
+    scale = (1 / (2 * math.pi), 1.0, 1.0)
+    estimates = [Estimate(key, float(fit.x[i] * scale[i]), float(std[i] * scale[i]),
+                          (run.name,), f"output error on pressure ({method})")
+                 for i, (key, method) in enumerate(zip(keys, (
+                     f"FRF fit gave {f_frf:.2f} Hz", f"FRF fit gave {zeta_frf:.3f}",
+                     "started from the dead time searched"), strict=False))]
+    fitted = p.replace({e.key: e.value for e in estimates}, "identify")
+    return estimates, actuator_frf(run, fitted), notes
+
+
+DYNAMICS_KEYS = (K.ACTUATOR_NATURAL_FREQUENCY_HZ, K.ACTUATOR_DAMPING_RATIO, K.ACTUATOR_DELAY_S)
+MAX_DELAY_S = 0.5  # the longest dead time looked for
+DELAY_GRID_S = 0.005  # the dead time's search step (its fit refines it)
+DELAY_SCALE_S = 0.01
+LATE_SHARE = 0.2  # a delay that takes this share of the pressure's squared error is said
+
+
+def _frf_fit(frf: FrfEstimate, p: RigParameters) -> tuple[float, float]:
+    """ω_n [Hz] and ζ of a second-order A(s) fitted to the FRF's coherent band."""
     f, h1 = frf.frequency_hz, frf.response
     band = ((f >= FRF_BAND_HZ[0]) & (f <= FRF_BAND_HZ[1]) & (frf.coherence > MIN_COHERENCE)
             & np.isfinite(h1))
     f0 = p.number(K.ACTUATOR_NATURAL_FREQUENCY_HZ)
-    zeta0 = p.number(K.ACTUATOR_DAMPING_RATIO)
     weight = np.sqrt(frf.coherence[band])
 
     def frf_residual(theta: np.ndarray) -> np.ndarray:
         diff = (second_order_response(f[band], theta[0] * f0, theta[1], 1.0) - h1[band]) * weight
         return np.concatenate([diff.real, diff.imag])
 
-    frf_fit = least_squares(frf_residual, [1.0, zeta0], bounds=([0.1, 0.05], [10.0, 3.0]))
-    f_frf, zeta_frf = frf_fit.x[0] * f0, frf_fit.x[1]
-    sensors = SensorModel.of(p)  # the model's pressure as its channel reads it (a late one)
+    fit = least_squares(frf_residual, [1.0, p.number(K.ACTUATOR_DAMPING_RATIO)],
+                        bounds=([0.1, 0.05], [10.0, 3.0]))
+    return float(fit.x[0] * f0), float(fit.x[1])
+
+
+def _time_residual(run: Run, p: RigParameters) -> Callable[[Sequence[float]], np.ndarray]:
+    """The pressure's error [bar] of A(s) at (ω_n [rad/s], ζ, delay [s]), as the channel
+    of ``p`` reads it (a late one too)."""
+    sensors = SensorModel.of(p)
     held = logged_to_held(run.current_a)
 
-    def time_residual(theta: np.ndarray) -> np.ndarray:
+    def residual(theta: Sequence[float]) -> np.ndarray:
         trial = p.replace({K.ACTUATOR_NATURAL_FREQUENCY_HZ: theta[0] / (2 * math.pi),
-                           K.ACTUATOR_DAMPING_RATIO: theta[1]})
+                           K.ACTUATOR_DAMPING_RATIO: theta[1], K.ACTUATOR_DELAY_S: theta[2]})
         read = sensors.pressure_channel(run.time_s, actuator_pressure(trial, held, run.rate_hz))
         return (read - run.pressure_pa) / PA_PER_BAR
 
-    wn_frf = 2 * math.pi * f_frf
-    fit = least_squares(time_residual, [wn_frf, zeta_frf], x_scale=[wn_frf, 0.1],
-                        bounds=([1.0, 0.05], [2000.0, 3.0]))
-    std = covariance_std(fit, 2)
-    names = (run.name,)
-    estimates = [
-        Estimate(K.ACTUATOR_NATURAL_FREQUENCY_HZ, fit.x[0] / (2 * math.pi),
-                 std[0] / (2 * math.pi), names,
-                 f"output error on pressure (FRF fit gave {f_frf:.2f} Hz)"),
-        Estimate(K.ACTUATOR_DAMPING_RATIO, fit.x[1], std[1], names,
-                 f"output error on pressure (FRF fit gave {zeta_frf:.3f})"),
-    ]
-    fitted = p.replace({e.key: e.value for e in estimates}, "identify")
-    return estimates, actuator_frf(run, fitted)
+    return residual
+
+
+def _dead_time_s(residual: Callable[[Sequence[float]], np.ndarray], wn: float,
+                 zeta: float) -> float:
+    """The delay of least squared error on a grid, at the FRF's ω_n and ζ (a dead time of
+    ~100 ms puts the optimiser's start from 0 in another valley)."""
+    grid = np.arange(0.0, MAX_DELAY_S, DELAY_GRID_S)
+    costs = [float(np.sum(residual([wn, zeta, delay]) ** 2)) for delay in grid]
+    return float(grid[int(np.argmin(costs))])
+
+
+def _late_note(plain_cost: float, delayed: OptimizeResult, rate_hz: float) -> list[str]:
+    """A note when A(s) with a delay leaves clearly less error than A(s) alone."""
+    delay = float(delayed.x[2])
+    if delay < 2.0 / rate_hz or delayed.cost > (1.0 - LATE_SHARE) * plain_cost:
+        return []
+    return [f"actuator dynamics A(s): the pressure follows the valve's current "
+            f"{1e3 * delay:.0f} ms later than A(s) alone can (a delay takes "
+            f"{100 * (1 - delayed.cost / plain_cost):.0f} % of its squared error); the model "
+            "has no delay, so ω_n and ζ absorb it: `diagnose` tests an actuator_delay, or a "
+            "datasheet with elements.actuator_delay: true has identify fit it"]

@@ -137,8 +137,9 @@ def _identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool,
     braking = select(classified, [Family.BRAKE])
 
     def dynamics() -> None:
-        found, state.frf = fit_actuator_dynamics(dynamic, state.params)
+        found, state.frf, notes = fit_actuator_dynamics(dynamic, state.params)
         state.adopt(found)
+        state.problems.extend(notes)
 
     if ramps or not dynamic:
         state.step("valve static map", ramps, "quasi-static ramp",

@@ -27,7 +27,7 @@ from landing_gear_sim.calibration.runs import (
     classify_all,
     select,
 )
-from landing_gear_sim.calibration.statistics import covariance_std
+from landing_gear_sim.calibration.statistics import covariance_std, input_timing_std_s
 from landing_gear_sim.diagnosis.objective import (
     Objective,
     Scales,
@@ -304,14 +304,6 @@ def _optimise(objective: Objective, start: np.ndarray, iterations: int) -> Optim
     """Least squares on the unit box from ``start``, at most ``iterations`` steps."""
     return least_squares(objective.fun, start, jac=objective.jac, bounds=(0.0, 1.0),
                          x_scale=0.01, ftol=FTOL, max_nfev=iterations)
-
-
-def input_timing_std_s(runs: Sequence[Run]) -> float:
-    """1-σ of when the logged current's changes really happened [s]: the logger shows a
-    change at the first sample after it, anywhere within a period (uniform: T/√12). A
-    delay cannot be known better (200 Hz logs: 1.4 ms; their fit alone claimed 0.07 ms
-    for a 2 ms error)."""
-    return 1.0 / (max(r.rate_hz for r in runs) * math.sqrt(12.0))
 
 
 @dataclass(frozen=True)

@@ -162,6 +162,8 @@ def actuator_step(p, matrices, xa, current_a):
 def valve_slot(p, pressure_pa, rate_pa_s, static_pa):
     """The valve's generic slot [Pa] at its state, ``static_pa`` the (delayed) static-map
     pressure it is driven by (0 on the reference rig)."""
+    if not basis.slot_acts(p, _VALVE_SLOT):
+        return 0.0
     error = p[_ACT_GAIN] * static_pa - pressure_pa
     return basis.slot_value(p, _VALVE_SLOT, (0.0, 0.0, pressure_pa, 0.0, 0.0, 0.0, 0.0, 0.0,
                                              0.0, 0.0, rate_pa_s, error))

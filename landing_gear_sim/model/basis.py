@@ -96,6 +96,17 @@ def term_value(code, signals):
     return value
 
 
+@njit(cache=True, inline="always")
+def slot_acts(p, first):
+    """Whether a term of the slot at ``p[first]`` has a coefficient (else it adds 0): a
+    caller that asks first builds no signals and makes no call, and an unused slot cost a
+    stop twice its time."""
+    for k in range(SLOT_TERMS):  # noqa: SIM110 (a loop numba compiles to three compares)
+        if p[first + 2 * k + 1] != 0.0:
+            return True
+    return False
+
+
 @njit(cache=True)
 def slot_value(p, first, signals):
     """An equation's slot: Σ coefficient·term over its SLOT_TERMS (code, coefficient) pairs

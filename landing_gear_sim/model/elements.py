@@ -130,6 +130,8 @@ def tyre_friction(p, slip, speed_m_s, vertical_load_n):
 def tyre_slot(p, slip, speed_m_s, vertical_load_n, curve):
     """The tyre equation's generic slot (``model.basis``): Σ c_k φ_k(|λ|, v, F_z, μ_B)
     added to μ, μ_B the curve at |λ| (0 on the reference rig)."""
+    if not basis.slot_acts(p, TYRE_SLOT):
+        return 0.0
     return basis.slot_value(p, TYRE_SLOT, (0.0, speed_m_s, 0.0, vertical_load_n, abs(slip),
                                            0.0, 0.0, 0.0, curve, 0.0, 0.0, 0.0))
 
@@ -345,5 +347,7 @@ def vertical_load_reference(p, time_s, speed_m_s):
 def loading_slot(p, speed_m_s, contact_time_s):
     """The loading equation's generic slot (``model.basis``): Σ c_k φ_k(v, t_c) [N] taken
     off the set point, t_c the time since touch-down (0 on the reference rig)."""
+    if not basis.slot_acts(p, LOADING_SLOT):
+        return 0.0
     return basis.slot_value(p, LOADING_SLOT, (0.0, speed_m_s, 0.0, 0.0, 0.0, 0.0, 0.0,
                                               contact_time_s, 0.0, 0.0, 0.0, 0.0))

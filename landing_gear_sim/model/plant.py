@@ -30,6 +30,7 @@ import math
 
 from numba import njit
 
+from landing_gear_sim.model import basis
 from landing_gear_sim.model import elements as el
 
 (SPEED, ANGLE, ANGLE_RATE, OMEGA, E_BRAKE, E_DRAG, E_SLIP, E_DAMP, TYRE_FORCE,
@@ -71,6 +72,8 @@ def tyre_state(p, x, vertical_load_n):
 @njit(cache=True, inline="always")
 def wheel_extra(p, x, pressure_pa, vertical_load_n, slip):
     """The torque of the wheel equation's slots at state ``x`` [N m]."""
+    if not basis.slot_acts(p, el.WHEEL_SLOT):
+        return el.wheel_extra_torque(p, x[OMEGA])
     signals = (x[OMEGA], x[SPEED], pressure_pa, vertical_load_n, abs(slip), x[E_BRAKE],
                x[WHEEL_ANGLE], 0.0, 0.0, 0.0, 0.0, 0.0)
     return el.wheel_extra_torque(p, x[OMEGA]) + el.wheel_slot_torque(p, signals)

@@ -189,6 +189,17 @@ def _load_lag_s(recorded: Run, offline: Run) -> float:
     return (first[0] - first[1]) * 1e-3
 
 
+def test_a_recorder_waits_for_a_runs_samples_while_they_still_arrive():
+    """A recorder on a busy machine had given up 5 s after the run's end with 831 of its
+    1500 samples while the rest were still arriving; it waits while messages come, and
+    gives up only after END_GRACE_S without one."""
+    from landing_gear_sim.ros.nodes.recorder import END_GRACE_S, keeps_waiting
+
+    assert keeps_waiting(831, 1500, quiet_s=0.01)  # 6 s after the end, still arriving
+    assert not keeps_waiting(831, 1500, quiet_s=END_GRACE_S + 0.1)  # nothing more came
+    assert not keeps_waiting(1500, 1500, quiet_s=0.0)  # all there
+
+
 def test_replay_publishes_a_run_that_the_recorder_writes_back(tmp_path, reference):
     measured = offline_run(SHORT)
     write_csv(measured, tmp_path / "run.csv")

@@ -176,7 +176,7 @@ def fit_actuator_dynamics(runs: Sequence[Run], p: RigParameters
 
 DYNAMICS_KEYS = (K.ACTUATOR_NATURAL_FREQUENCY_HZ, K.ACTUATOR_DAMPING_RATIO, K.ACTUATOR_DELAY_S)
 MAX_DELAY_S = 0.5  # the longest dead time looked for
-DELAY_GRID_S = 0.005  # the dead time's search step (its fit refines it)
+DELAY_GRID_S = 0.01  # the dead time's search step (its fit refines it)
 DELAY_SCALE_S = 0.01
 LATE_SHARE = 0.2  # a delay that takes this share of the pressure's squared error is said
 

@@ -33,12 +33,15 @@ def scaled_error(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequen
 def scaled_residuals(runs: Sequence[Run], sets: Sequence[RigParameters],
                      channels: Sequence[str], scales: Scales) -> list[np.ndarray]:
     """:func:`scaled_error` of each parameter set of ``sets``, every (set, run) simulated
-    side by side."""
-    pairs = [(params, run) for params in sets for run in runs]
-    simulated = map_threads(lambda pair: simulate_run(pair[1], pair[0])[0], pairs)
+    side by side (each simulation reduced to its error at once: a Jacobian's simulations
+    held together had cost a diagnosis 200 MB)."""
+    def error(pair: tuple[RigParameters, Run]) -> np.ndarray:
+        params, run = pair
+        return scaled_error([run], [simulate_run(run, params)[0]], channels, scales)
+
+    errors = map_threads(error, [(params, run) for params in sets for run in runs])
     n = len(runs)
-    return [scaled_error(runs, simulated[i * n:(i + 1) * n], channels, scales)
-            for i in range(len(sets))]
+    return [np.concatenate(errors[i * n:(i + 1) * n]) for i in range(len(sets))]
 
 
 class Objective:

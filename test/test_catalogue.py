@@ -126,6 +126,11 @@ def test_candidates_that_refit_the_same_base_parameters_share_one_null_fit(refer
     acting = reference.replace({code: 17.0, coefficient: 3.0})
     scoring._null_fit(candidate, runs, acting, reference, scales)
     assert len(fits) == 2
+    fitting_it = replace(candidate, free=(*candidate.free, coefficient))  # its code matters
+    for value in (17.0, 33.0):
+        scoring._null_fit(fitting_it, runs, reference.replace({code: value}), reference,
+                          scales)
+    assert len(fits) == 4
 
 
 def test_a_pool_task_takes_the_cores_the_pools_other_tasks_leave(monkeypatch):

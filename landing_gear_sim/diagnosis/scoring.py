@@ -271,7 +271,7 @@ def _null_key(candidate: Candidate, runs: Sequence[Run], model: RigParameters,
     free = [k for k in candidate.free if k not in candidate.keys]
     names = {r.name for r in runs}
     digest.update(json.dumps([free, list(candidate.channels), [str(f) for f in candidate.runs],
-                              _acting(model), _acting(datasheet),
+                              _acting(model, free), _acting(datasheet, free),
                               sorted((f"{n}/{c}", v) for (n, c), v in scales.items()
                                      if n in names)], default=str).encode())
     for run in runs:
@@ -281,11 +281,16 @@ def _null_key(candidate: Candidate, runs: Sequence[Run], model: RigParameters,
     return digest.hexdigest()
 
 
-def _acting(params: RigParameters) -> dict[str, object]:
-    """``params``' values less the codes of slot terms whose coefficient is 0: no term
-    (a family's proposals set their terms' codes, and their nulls are one fit)."""
-    return {k: v for k, v in params.values.items()
-            if not (k.endswith("_code") and params.values.get(f"{k[:-5]}_coeff", 1.0) == 0.0)}
+def _acting(params: RigParameters, free: Sequence[str]) -> dict[str, object]:
+    """``params``' values less the codes of slot terms whose coefficient is 0 and not
+    fitted: no term (a family's proposals set their terms' codes, and their nulls are one
+    fit)."""
+    def idle(key: str) -> bool:
+        coefficient = f"{key[:-5]}_coeff"
+        return (key.endswith("_code") and coefficient not in free
+                and params.values.get(coefficient, 1.0) == 0.0)
+
+    return {k: v for k, v in params.values.items() if not idle(k)}
 
 
 ACCEPTED = "meets every rule (ΔBIC, held-out gain, parameters within range)"

@@ -179,6 +179,7 @@ MAX_DELAY_S = 0.5  # the longest dead time looked for
 DELAY_GRID_S = 0.01  # the dead time's search step (its fit refines it)
 DELAY_SCALE_S = 0.01
 LATE_SHARE = 0.2  # a delay that takes this share of the pressure's squared error is said
+LATE = "later than A(s) alone can"  # the note's words, which a diagnosis that tests a delay drops
 
 
 def _frf_fit(frf: FrfEstimate, p: RigParameters) -> tuple[float, float]:
@@ -230,7 +231,7 @@ def _late_note(plain_cost: float, delayed: OptimizeResult, rate_hz: float) -> li
     if delay < 2.0 / rate_hz or delayed.cost > (1.0 - LATE_SHARE) * plain_cost:
         return []
     return [f"actuator dynamics A(s): the pressure follows the valve's current "
-            f"{1e3 * delay:.0f} ms later than A(s) alone can (a delay takes "
+            f"{1e3 * delay:.0f} ms {LATE} (a delay takes "
             f"{100 * (1 - delayed.cost / plain_cost):.0f} % of its squared error); the model "
             "has no delay, so ω_n and ζ absorb it: `diagnose` tests an actuator_delay, or a "
             "datasheet with elements.actuator_delay: true has identify fit it"]

@@ -33,8 +33,8 @@ def scaled_error(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequen
 def scaled_residuals(runs: Sequence[Run], sets: Sequence[RigParameters],
                      channels: Sequence[str], scales: Scales) -> list[np.ndarray]:
     """:func:`scaled_error` of each parameter set of ``sets``, every (set, run) simulated
-    side by side (each simulation reduced to its error at once: a Jacobian's simulations
-    held together had cost a diagnosis 200 MB)."""
+    side by side, each simulation reduced to its error as it comes (a Jacobian's
+    simulated runs are never held all at once)."""
     def error(pair: tuple[RigParameters, Run]) -> np.ndarray:
         params, run = pair
         return scaled_error([run], [simulate_run(run, params)[0]], channels, scales)

@@ -111,7 +111,7 @@ def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     if p[el.HAS_RELAXATION]:
         steady = vertical_load_n * el.tyre_friction(p, slip, x[SPEED], vertical_load_n)
         dx[TYRE_FORCE] = el.relaxation_rate(p, hub) * (steady - x[TYRE_FORCE])
-    else:  # the force is the steady one (tyre_state's): evaluating μ again cost ~30 %
+    else:  # the force is the steady one (tyre_state's): evaluating μ again cost ~20 %
         dx[TYRE_FORCE] = 0.0
     dx[WHEEL_ANGLE] = x[OMEGA]
 

@@ -52,6 +52,7 @@ from landing_gear_sim.diagnosis.scoring import (
     HELD_OUT_THRESHOLD,
     Scored,
     channel_fits,
+    forget_null_fits,
     key_std,
     score_candidate,
 )
@@ -127,7 +128,10 @@ def diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str] = 
     # a candidate model that diverges (a valve fitted on one apply, run on a release) scores
     # inf and is rejected: its overflow is not the user's to read
     with single_threaded_blas(), np.errstate(over="ignore", invalid="ignore"):
-        return _diagnose(runs, base, without, progress)
+        try:
+            return _diagnose(runs, base, without, progress)
+        finally:
+            forget_null_fits()
 
 
 def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],

@@ -246,6 +246,12 @@ _NULLS: dict[str, CandidateFit] = {}
 NULLS_KEPT = 32
 
 
+def forget_null_fits() -> None:
+    """Drop the null fits kept (:func:`_null_fit`): a diagnosis shares its own, and a
+    process that diagnoses many campaigns (a bench, a Dask worker) need not carry them."""
+    _NULLS.clear()
+
+
 def _null_fit(candidate: Candidate, runs: Sequence[Run], model: RigParameters,
               datasheet: RigParameters, scales: Scales) -> CandidateFit:
     """``candidate``'s null fitted on ``runs``, once: candidates that re-fit the same base

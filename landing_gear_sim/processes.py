@@ -26,6 +26,11 @@ def die_with_parent() -> None:
     libc.prctl(PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
+Counter = Any  # a multiprocessing.Value("i"): its type is not importable
+_THREADS = os.cpu_count() or 1
+_BUSY: Counter | None = None
+
+
 def pool_worker(busy: Counter | None = None) -> None:
     """Initializer of a worker-pool process: dies with its parent, leaves Ctrl-C to it (the
     parent stops the pool), and ends on SIGTERM at once (without the parent's handlers,
@@ -37,11 +42,6 @@ def pool_worker(busy: Counter | None = None) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     _THREADS, _BUSY = 1, busy
-
-
-Counter = Any  # a multiprocessing.Value("i"): its type is not importable
-_THREADS = os.cpu_count() or 1
-_BUSY: Counter | None = None
 
 
 def busy_counter() -> Counter:

@@ -18,7 +18,6 @@ import numpy as np
 from scipy.optimize import OptimizeResult, least_squares
 
 from landing_gear_sim.calibration import braking as br
-from landing_gear_sim.calibration.measured import simulate_all
 from landing_gear_sim.calibration.runs import (
     ClassifiedRun,
     Family,
@@ -31,7 +30,6 @@ from landing_gear_sim.calibration.statistics import covariance_std, input_timing
 from landing_gear_sim.diagnosis.objective import (
     Objective,
     Scales,
-    scaled_error,
     scaled_residuals,
 )
 from landing_gear_sim.errors import IdentificationError
@@ -216,12 +214,6 @@ def noise_scales(runs: Sequence[Run], channels: Sequence[str]) -> Scales:
     return {(r.name, c): noise_std(getattr(r, c)) for r in runs for c in channels}
 
 
-def scaled_residual(runs: Sequence[Run], params: RigParameters, channels: Sequence[str],
-                    scales: Scales) -> np.ndarray:
-    """Simulation minus measurement over ``channels`` of ``runs``, divided by the noise."""
-    return scaled_error(runs, simulate_all(runs, params), channels, scales)
-
-
 def switched_on(candidate: Candidate, params: RigParameters) -> RigParameters:
     """``params`` with the candidate's element on, its keys at their first start values."""
     if candidate.element is None:
@@ -258,7 +250,7 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
     references = [base] + ([datasheet] if datasheet is not None else [])
     keys = [*own, *free]
     if not keys:
-        error = scaled_residual(chosen, model, candidate.channels, scales)
+        (error,) = scaled_residuals(chosen, [model], candidate.channels, scales)
         return CandidateFit(candidate, model, {}, {}, error)
     own_bounds = candidate.bounds if own else ()
     lower = np.array([b[0] for b in own_bounds]

@@ -23,8 +23,9 @@ another rate, a counting encoder, a noisy quantised current, a dropout; see
 ``landing_gear_sim.calibration.logger``).
 
 Effects no family or slot term is (``OUTSIDE``, issue 41): laws outside every equation's
-library — two kinds per equation with a generic slot (the wheel's, the tyre's, the loading
-device's, the F_x channel's), drawn here through the plant's generic slots; right when
+library — two kinds per equation with a generic slot (the wheel's, the tyre's, the flywheel's,
+the loading device's, the valve's A(s), the F_x channel's), drawn here through the plant's
+generic slots; right when
 discovered in the equation with a held-out gain (no value: no term of the library is the
 law). ``--causes`` names them like the others.
 
@@ -167,6 +168,19 @@ OUTSIDE: dict[str, tuple[str, Draw]] = {
     # a peak that sharpens at speed: μ_B²·v
     "tyre_peak_speed": ("tyre", _slot(K.TYRE_TERMS, _product(
         (basis.CURVE, basis.SQUARE), (basis.SPEED, basis.IDENTITY)), (-0.012, -0.006))),
+    # a flywheel bearing whose friction grows with the root of the load the tyre presses
+    # on it: sgn v·√F_z (210-390 N at 32 kN)
+    "flywheel_bearing_root_load": ("flywheel", _slot(K.FLYWHEEL_TERMS, _product(
+        (basis.SPEED, basis.SIGN), (basis.LOAD, basis.SIGNED_ROOT)), (1.2, 2.2))),
+    # eddy currents that grow with the root of the rim's speed: √v (160-460 N at 30-60 m/s)
+    "flywheel_eddy_root": ("flywheel", _slot(K.FLYWHEEL_TERMS, basis.factor_code(
+        basis.SPEED, basis.SIGNED_ROOT), (30.0, 60.0))),
+    # a valve that opens faster than it closes: [Ṗ > 1 bar/s]·ΔP in A(s)
+    "valve_rising_stiffer": ("valve", _slot(K.VALVE_TERMS, _product(
+        (basis.PRESSURE_RATE, basis.STEP), (basis.VALVE_ERROR, basis.IDENTITY)), (0.4, 0.8))),
+    # a second stage that opens beyond half a bar of error: ΔP through a dead zone in A(s)
+    "valve_second_stage": ("valve", _slot(K.VALVE_TERMS, basis.factor_code(
+        basis.VALVE_ERROR, basis.DEAD_ZONE), (0.3, 0.6))),
     # a load cell's zero that drifts in proportion to the load it carries: √t·F_z
     "fx_drift_load": ("F_x channel", _slot(K.FX_TERMS, _product(
         (basis.RUN_TIME, basis.SIGNED_ROOT), (basis.LOAD, basis.IDENTITY)), (1e-3, 3e-3))),

@@ -239,7 +239,7 @@ def test_a_valve_map_that_bends_is_discovered_in_the_valve_not_named_a_valve_eff
     finding = result.findings[0]
     assert finding.family == "valve" and finding.held_out < 0
     assert finding.term.startswith("P_static = ") and "e³" in finding.term
-    assert finding.parameters["extra_map_pa_per_a3"] == pytest.approx(bend, rel=0.1)
+    assert finding.parameters["e³"] == pytest.approx(bend, rel=0.1)
 
 
 def test_of_two_causes_beside_a_discovered_term_only_the_one_it_replaces_goes(reference,

@@ -14,6 +14,7 @@ import scipy.signal
 from scipy.optimize import OptimizeResult, least_squares
 
 from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.calibration.slots import Slot, map_signals
 from landing_gear_sim.calibration.statistics import Estimate, covariance_std, input_timing_std_s
 from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model import elements as el
@@ -45,7 +46,7 @@ class FrfEstimate:
 
 def fit_static_map(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
     """Dead-band, k1, k2, saturation from quasi-static ramps (paper Fig. 8), beside the
-    map's generic slot k3 of ``p`` (read around, as the other calibrations read around
+    map's k3 and slot of ``p`` (read around, as the other calibrations read around
     theirs)."""
     current = np.concatenate([r.current_a for r in runs])
     pressure = np.concatenate([r.pressure_pa for r in runs])
@@ -111,13 +112,23 @@ def _fit_map(current: np.ndarray, pressure_measured: np.ndarray, p: RigParameter
         trial = values.copy()
         trial[free] = theta * scale[free]
         deadband, k1, k2, max_pressure = trial
-        return (el.valve_map(current, max_current, deadband, k1, k2, k3, max_pressure)
+        return (el.valve_map(current, max_current, deadband, k1, k2, k3, max_pressure,
+                             _map_slot(p, current, max_current, deadband))
                 - pressure) / PA_PER_BAR
 
     fit = least_squares(residual, values[free] / scale[free], x_scale="jac")
     std = covariance_std(fit, int(free.sum())) * scale[free]
     return [Estimate(k, float(v), float(e), names, method)
             for k, v, e in zip(keys, fit.x * scale[free], std, strict=True)]
+
+
+def _map_slot(p: RigParameters, current: np.ndarray, max_current: float, deadband: float
+              ) -> np.ndarray | float:
+    """The map's slot of ``p`` at ``current`` with the dead-band tried [Pa] (0.0: none)."""
+    if not Slot.STATIC_MAP.occupied(p):
+        return 0.0
+    return Slot.STATIC_MAP.value_of(p, map_signals(el.valve_excess(current, max_current,
+                                                                    deadband)))
 
 
 def actuator_frf(run: Run, params: RigParameters) -> FrfEstimate:

@@ -172,8 +172,8 @@ def fit_flywheel(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
         if idx.size < 20:
             continue
         dt = np.diff(b.time_s, prepend=b.time_s[0])
-        # the flywheel's generic slot is known, like F_x (0 unless a diagnosis found one)
-        force = b.force + flywheel_extra_force(p.vector(), b.speed_m_s)
+        # the flywheel's slots are known, like F_x (0 unless a diagnosis found a term)
+        force = b.force + flywheel_extra(b, p)
         blocks.append(np.column_stack([-np.cumsum(force * dt)[idx],
                                        -np.cumsum(b.speed_m_s ** 2 * dt)[idx]]))
         targets.append(b.speed_m_s[idx])
@@ -223,6 +223,17 @@ def _absorbed(b: Braking, torque: np.ndarray) -> np.ndarray:
     power = np.where(b.time_s > b.start_s - 0.1, np.clip(torque, 0, None), 0.0) \
         * np.clip(b.wheel, 0, None)
     return np.cumsum(power * dt)
+
+
+def flywheel_extra(b: Braking, p: RigParameters) -> np.ndarray:
+    """The force of the flywheel equation's slots at each sample of ``b`` [N], opposing the
+    motion beside the drag (the plant's ``flywheel_extra``, at the measured speed and load)."""
+    named = flywheel_extra_force(p.vector(), b.speed_m_s)
+    if not Slot.FLYWHEEL.occupied(p):
+        return named
+    measured = signals(b.time_s, b.wheel, b.speed_m_s, b.pressure, b.load,
+                       np.zeros(b.time_s.size), p)
+    return named + Slot.FLYWHEEL.value_of(p, measured)
 
 
 def measured_signals(b: Braking, p: RigParameters, energy: np.ndarray) -> np.ndarray:

@@ -22,20 +22,24 @@ from landing_gear_sim.model.quantities import friction_at, rolling_radius_at
 
 
 class Slot(str, enum.Enum):
-    """An equation with a generic slot (compares equal to its section of the schema)."""
+    """An equation with a generic slot (its value names it: its keys' section, or the
+    section and the equation where a section holds two)."""
 
     WHEEL = "wheel"
     TYRE = "friction"
     LOADING = "loading"
     FX_CHANNEL = "sensors"
     VALVE = "actuator"
+    FLYWHEEL = "flywheel"
+    STATIC_MAP = "actuator_map"
 
     @property
     def keys(self) -> tuple[tuple[str, str], ...]:
         """Its (code, coefficient) keys."""
         return {"wheel": K.WHEEL_TERMS, "friction": K.TYRE_TERMS,
                 "loading": K.LOADING_TERMS, "sensors": K.FX_TERMS,
-                "actuator": K.VALVE_TERMS}[self.value]
+                "actuator": K.VALVE_TERMS, "flywheel": K.FLYWHEEL_TERMS,
+                "actuator_map": K.MAP_TERMS}[self.value]
 
     def value_of(self, params: RigParameters, measured: np.ndarray) -> np.ndarray:
         """The slot of ``params`` at each row of ``measured`` (:func:`signals`)."""
@@ -55,8 +59,17 @@ SEES: dict[Slot, tuple[int, ...]] = {
     Slot.LOADING: (basis.SPEED, basis.CONTACT_TIME),
     Slot.FX_CHANNEL: (basis.LOAD, basis.RUN_TIME),
     Slot.VALVE: (basis.PRESSURE, basis.PRESSURE_RATE, basis.VALVE_ERROR),
+    Slot.FLYWHEEL: (basis.SPEED, basis.LOAD),
+    Slot.STATIC_MAP: (basis.VALVE_CURRENT,),
 }
 """The signals each equation's slot sees in the plant (``model.elements``)."""
+
+
+def map_signals(excess_a: np.ndarray) -> np.ndarray:
+    """The static map's signals at the map's variables ``excess_a`` (e = I − I0 [A])."""
+    out = np.zeros((np.size(excess_a), basis.N_SIGNALS))
+    out[:, basis.VALVE_CURRENT] = excess_a
+    return out
 
 
 def seen(slot: Slot, measured: np.ndarray) -> np.ndarray:

@@ -6,10 +6,10 @@ tyre's force law, the flywheel's momentum balance, the loading device's law and 
 channel, the error is computed from the measured signals under the model (the other
 equations' terms measured) over the samples that carry it: the actuator runs' for the valve,
 every braking run's thinned to the filter's bandwidth for the others. Each equation's
-library is the terms of its slot in the plant — the generic slots' basis functions composed
-with :mod:`~.terms` (``wheel.term_*``, ``friction.term_*``, ``loading.term_*``,
-``sensors.fx_term_*``, ``actuator.term_*``), the named ones' terms (``actuator.extra_*``,
-``flywheel.extra_*``) — beside the terms whose coefficients the calibration owns (the map's
+library is the terms of its generic slot in the plant, basis functions composed with
+:mod:`~.terms` (``actuator.map_term_*``, ``actuator.term_*``, ``wheel.term_*``,
+``friction.term_*``, ``flywheel.term_*``, ``loading.term_*``, ``sensors.fx_term_*``),
+beside the terms whose coefficients the calibration owns (the map's
 1, e, e²; k_b P in the wheel's; the curve's ϑ; the flywheel's mass and drag; the lift).
 :mod:`~.selection` picks the terms the error needs; the equation's relation
 (:class:`~.relations.Relation`) is then violated, and the equation's family
@@ -37,7 +37,7 @@ from landing_gear_sim.diagnosis.library import (
     thinned,
 )
 from landing_gear_sim.diagnosis.relations import Check, Relation
-from landing_gear_sim.diagnosis.selection import Rows, Term, basis_terms, term_columns, variable
+from landing_gear_sim.diagnosis.selection import Rows, Term, basis_terms, term_columns
 from landing_gear_sim.diagnosis.terms import Shaped, Without
 from landing_gear_sim.diagnosis.valve_library import VALVE, VALVE_DYNAMICS
 from landing_gear_sim.model import basis
@@ -92,19 +92,26 @@ class WheelLibrary(BrakingLibrary):
         return f"J_w·ω̇ = r·F_x − T_b {written}"
 
 
+FLYWHEEL_TERMS = (Shaped((basis.SPEED,), (basis.SIGN, basis.IDENTITY, basis.CUBE))
+                  + Shaped((basis.SPEED,), (basis.SIGN, basis.IDENTITY))
+                  * Shaped((basis.LOAD,), (basis.IDENTITY,)))
+"""The flywheel's library: its speed in the powers a bearing's friction, eddy currents or a
+windage take, and the load the tyre presses on its bearings; α_d v² is the calibration's
+own."""
+
+
 class FlywheelLibrary(BrakingLibrary):
-    """The flywheel's momentum balance m_f v̇ = −F_x − α_d v² − F₀ sgn v − F₁ v: its
+    """The flywheel's momentum balance m_f v̇ = −F_x − α_d v² − Σ c_k φ_k(v, F_z): its
     bearings' friction, eddy currents. Its error is measured integrated over the run,
     m_f v + ∫(F_x + α_d v²) dt about each run's mean, as the calibration measures the
     balance (the differentiated one carries m_f times the speed's noise: 2.7 kN rms)."""
 
     equation = Equation.FLYWHEEL
     relation = Relation.FLYWHEEL_BALANCE
-    unit = "N s"
-    terms = (
-        Term(K.FLYWHEEL_EXTRA_FORCE_N, "", "N", 5000.0, lambda b, _: -np.sign(b.speed_m_s)),
-        Term(K.FLYWHEEL_EXTRA_FORCE_N_S_PER_M, "·v", "N s/m", 100.0, lambda b, _: -b.speed_m_s),
-    )
+    unit = "N"
+    error_unit = "N s"
+    slot = Slot.FLYWHEEL
+    terms = basis_terms(FLYWHEEL_TERMS, "N")
 
     def rows(self, b: br.Braking, params: RigParameters,
              terms: Sequence[Term[br.Braking]] | None = None) -> Rows | None:
@@ -116,9 +123,13 @@ class FlywheelLibrary(BrakingLibrary):
         speed = b.speed_m_s
         balance = momentum_balance(b, params)
         impulse = balance - el.translational_mass(params.vector()) * speed
-        columns = [np.cumsum(variable(t, b, params) * dt) for t in terms or self.terms]
+        measured = seen(Slot.FLYWHEEL, br.measured_signals(b, params, np.zeros(speed.size)))
+        everywhere = np.arange(speed.size)
+        # a term opposes the motion: the balance's error is minus its impulse
+        columns = -np.cumsum(term_columns(terms or self.terms, b, params, everywhere, measured)
+                             * dt[:, None], axis=0)
         owned = [speed, np.cumsum(speed * speed * dt)]
-        return about_run_mean(balance[index], np.column_stack(columns)[index],
+        return about_run_mean(balance[index], columns[index],
                                np.column_stack(owned)[index], float(np.std(impulse[index])))
 
     def law(self, written: str, params: RigParameters) -> str:
@@ -295,7 +306,7 @@ def momentum_balance(b: br.Braking, params: RigParameters) -> np.ndarray:
     p = params.vector()
     dt = np.diff(b.time_s, prepend=b.time_s[0])
     speed = b.speed_m_s
-    resisting = b.force + el.drag_forces(p, speed) + el.flywheel_extra_force(p, speed)
+    resisting = b.force + el.drag_forces(p, speed) + br.flywheel_extra(b, params)
     return el.translational_mass(p) * speed + np.cumsum(resisting * dt)
 
 

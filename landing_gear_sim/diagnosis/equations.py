@@ -115,7 +115,7 @@ def equation_errors(run: ClassifiedRun, params: RigParameters, simulated: Run
     wheel = torque - br.model_torque(b, params, energy, np.arange(b.time_s.size))
     p = params.vector()
     speed = b.speed_m_s[window]
-    drag = el.drag_forces(p, speed) + el.flywheel_extra_force(p, speed)
+    drag = el.drag_forces(p, speed) + br.flywheel_extra(b, params)[window]
     flywheel = el.translational_mass(p) * np.gradient(b.speed_m_s, 1.0 / run.rate_hz)[window] \
         + b.force[window] + drag
     loading = run.vertical_load_n - simulated.vertical_load_n

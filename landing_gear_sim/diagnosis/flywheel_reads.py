@@ -21,7 +21,9 @@ def flywheel_carries(braking: Sequence[br.Braking], params: RigParameters,
     flywheel does not feel: its coefficient in the flywheel's balance error, and its t
     (0, 0: no run to tell). A channel's error shows wherever the channel is read; a torque
     on the wheel (a bearing's) does not reach the flywheel's balance."""
-    carried = (Term[br.Braking]("", "", "", 0.0, lambda b, _: values(b)),)
+    # the reading's excess adds to the balance as a force that pushes the flywheel: the
+    # library's terms oppose its motion
+    carried = (Term[br.Braking]("", "", "", 0.0, lambda b, _: -values(b)),)
     rows = [r for b in braking if (r := FLYWHEEL.rows(b, params, carried)) is not None]
     if not rows:
         return 0.0, 0.0

@@ -48,7 +48,7 @@ class Campaign:
 
 class Library(abc.ABC, Generic[S]):
     """One equation's generic slot (see the module docstring): its ``terms``, the relation
-    that says whether its error needs them, the unit of its error, the runs it reads
+    that says whether its error needs them, the unit of its law and its error, the runs it reads
     (``phase``, in words), and the sign its terms are written with in its law (−1: they
     oppose, as a bearing's friction)."""
 
@@ -57,6 +57,7 @@ class Library(abc.ABC, Generic[S]):
     terms: tuple[Term[S], ...]
     unit: str
     phase: str
+    error_unit: str = ""  # its error's, when not the law's (a balance integrated over time)
     sign: float = -1.0
     slot: Slot | None = None  # the generic slot its basis terms take places in
     min_effect: float = MIN_EFFECT  # of the equation's scale: below it a term does not matter
@@ -92,7 +93,7 @@ class Library(abc.ABC, Generic[S]):
         named = ", ".join(s.term.name for s in fitted.selected)
         return Check(self.relation, "campaign", f"{self.phase}, {named}", fitted.effect,
                      fitted.effect / max(fitted.z, 1e-12), floor_of(rows, self.min_effect),
-                     self.unit)
+                     self.error_unit or self.unit)
 
     def _rows(self, campaign: Campaign, params: RigParameters) -> list[Rows]:
         return [r for s in self.sources(campaign, params)

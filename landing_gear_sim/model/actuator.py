@@ -166,7 +166,7 @@ def valve_slot(p, pressure_pa, rate_pa_s, static_pa):
         return 0.0
     error = p[_ACT_GAIN] * static_pa - pressure_pa
     return basis.slot_value(p, _VALVE_SLOT, (0.0, 0.0, pressure_pa, 0.0, 0.0, 0.0, 0.0, 0.0,
-                                             0.0, 0.0, rate_pa_s, error))
+                                             0.0, 0.0, rate_pa_s, error, 0.0))
 
 
 @njit(cache=True)

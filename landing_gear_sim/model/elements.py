@@ -89,10 +89,14 @@ MAP_EXTRA_3 = INDEX[K.ACTUATOR_EXTRA_MAP_PA_PER_A3]
 WHEEL_SLOT = INDEX[K.WHEEL_TERMS[0][0]]
 TYRE_SLOT = INDEX[K.TYRE_TERMS[0][0]]
 LOADING_SLOT = INDEX[K.LOADING_TERMS[0][0]]
+FLYWHEEL_SLOT = INDEX[K.FLYWHEEL_TERMS[0][0]]
+MAP_SLOT = INDEX[K.MAP_TERMS[0][0]]
 # a slot's (code, coefficient) pairs are read as consecutive entries
 assert INDEX[K.WHEEL_TERMS[-1][1]] == WHEEL_SLOT + 2 * basis.SLOT_TERMS - 1
 assert INDEX[K.TYRE_TERMS[-1][1]] == TYRE_SLOT + 2 * basis.SLOT_TERMS - 1
 assert INDEX[K.LOADING_TERMS[-1][1]] == LOADING_SLOT + 2 * basis.SLOT_TERMS - 1
+assert INDEX[K.FLYWHEEL_TERMS[-1][1]] == FLYWHEEL_SLOT + 2 * basis.SLOT_TERMS - 1
+assert INDEX[K.MAP_TERMS[-1][1]] == MAP_SLOT + 2 * basis.SLOT_TERMS - 1
 
 
 @njit(cache=True, inline="always")
@@ -133,7 +137,7 @@ def tyre_slot(p, slip, speed_m_s, vertical_load_n, curve):
     if not basis.slot_acts(p, TYRE_SLOT):
         return 0.0
     return basis.slot_value(p, TYRE_SLOT, (0.0, speed_m_s, 0.0, vertical_load_n, abs(slip),
-                                           0.0, 0.0, 0.0, curve, 0.0, 0.0, 0.0))
+                                           0.0, 0.0, 0.0, curve, 0.0, 0.0, 0.0, 0.0))
 
 
 @njit(cache=True)
@@ -306,21 +310,27 @@ def valve_excess(current_a, max_current_a, deadband_a):
 
 @njit(cache=True, inline="always")
 def valve_map(current_a, max_current_a, deadband_a, k1_pa_per_a, k2_pa_per_a2, k3_pa_per_a3,
-              max_pressure_pa):
-    """Static current→pressure map P = k1 e + k2 e² + k3 e³ (:func:`valve_excess`),
-    dead-band I0, saturation P_max [Pa]; k3 is the valve equation's generic slot (0 on the
-    reference rig)."""
+              max_pressure_pa, extra_pa=0.0):
+    """Static current→pressure map P = k1 e + k2 e² + k3 e³ + the map's slot ``extra_pa``
+    (:func:`valve_excess`), dead-band I0, saturation P_max [Pa]; k3 is the map's named
+    term (0 on the reference rig)."""
     excess = valve_excess(current_a, max_current_a, deadband_a)
     pressure = (k1_pa_per_a * excess + k2_pa_per_a2 * excess * excess
-                + k3_pa_per_a3 * excess * excess * excess)
+                + k3_pa_per_a3 * excess * excess * excess) + extra_pa
     return np.minimum(np.maximum(pressure, 0.0), max_pressure_pa)
 
 
 @njit(cache=True)
 def valve_static_pressure(p, current_a):
-    """The valve's static-map pressure [Pa] of the parameter set at ``current_a`` [A]."""
+    """The valve's static-map pressure [Pa] of the parameter set at ``current_a`` [A] (a
+    float)."""
+    extra = 0.0
+    if basis.slot_acts(p, MAP_SLOT):
+        excess = valve_excess(current_a, p[MAX_CURRENT], p[DEADBAND])
+        extra = basis.slot_value(p, MAP_SLOT, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+                                               0.0, 0.0, excess))
     return valve_map(current_a, p[MAX_CURRENT], p[DEADBAND], p[MAP_K1], p[MAP_K2],
-                     p[MAP_EXTRA_3], p[MAX_PRESSURE])
+                     p[MAP_EXTRA_3], p[MAX_PRESSURE], extra)
 
 
 @njit(cache=True)
@@ -350,4 +360,4 @@ def loading_slot(p, speed_m_s, contact_time_s):
     if not basis.slot_acts(p, LOADING_SLOT):
         return 0.0
     return basis.slot_value(p, LOADING_SLOT, (0.0, speed_m_s, 0.0, 0.0, 0.0, 0.0, 0.0,
-                                              contact_time_s, 0.0, 0.0, 0.0, 0.0))
+                                              contact_time_s, 0.0, 0.0, 0.0, 0.0, 0.0))

@@ -75,8 +75,20 @@ def wheel_extra(p, x, pressure_pa, vertical_load_n, slip):
     if not basis.slot_acts(p, el.WHEEL_SLOT):
         return el.wheel_extra_torque(p, x[OMEGA])
     signals = (x[OMEGA], x[SPEED], pressure_pa, vertical_load_n, abs(slip), x[E_BRAKE],
-               x[WHEEL_ANGLE], 0.0, 0.0, 0.0, 0.0, 0.0)
+               x[WHEEL_ANGLE], 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     return el.wheel_extra_torque(p, x[OMEGA]) + el.wheel_slot_torque(p, signals)
+
+
+@njit(cache=True, inline="always")
+def flywheel_extra(p, x, vertical_load_n):
+    """The force of the flywheel equation's slots at state ``x`` [N], opposing the motion
+    beside the drag: its bearings carry the load the tyre presses on the rim."""
+    if not basis.slot_acts(p, el.FLYWHEEL_SLOT):
+        return el.flywheel_extra_force(p, x[SPEED])
+    signals = (0.0, x[SPEED], 0.0, vertical_load_n, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+               0.0)
+    return el.flywheel_extra_force(p, x[SPEED]) + basis.slot_value(p, el.FLYWHEEL_SLOT,
+                                                                    signals)
 
 
 @njit(cache=True)
@@ -84,7 +96,7 @@ def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     """Write dx/dt of the plant state into ``dx`` (eqs. 1-8; rig or aircraft form)."""
     radius, hub, slip, fx = tyre_state(p, x, vertical_load_n)
     tb = el.brake_torque(p, pressure_pa, x[E_BRAKE], x[OMEGA], x[WHEEL_ANGLE])
-    drag = el.drag_force(p, x[SPEED]) + el.flywheel_extra_force(p, x[SPEED])
+    drag = el.drag_force(p, x[SPEED]) + flywheel_extra(p, x, vertical_load_n)
     mass = el.translational_mass(p)
     if p[el.HAS_GEAR_WALK] == 0.0:
         accel, angle_accel = (-fx - drag) / mass, 0.0

@@ -272,7 +272,8 @@ def current_for_pressure(params: RigParameters, pressure_pa: float) -> float:
         raise ScenarioError(f"pressure {pressure_pa / PA_PER_BAR:g} bar is outside the valve "
                             f"range 0..{p_max / PA_PER_BAR:g} bar")
     target = pressure_pa / params.number(K.ACTUATOR_GAIN)
-    if params.number(K.ACTUATOR_EXTRA_MAP_PA_PER_A3):
+    if params.number(K.ACTUATOR_EXTRA_MAP_PA_PER_A3) or any(
+            params.number(coeff) for _, coeff in K.MAP_TERMS):
         current = _map_root(params, target)
     else:
         excess = target / k1 if k2 == 0 else (
@@ -285,19 +286,19 @@ def current_for_pressure(params: RigParameters, pressure_pa: float) -> float:
 
 
 def _map_root(params: RigParameters, target_pa: float) -> float:
-    """The current [A] at which the model's own static map (its cubic term included: no
-    closed-form inverse) first reaches ``target_pa``, bracketed on a grid of the valve's
-    range (inf: it never does)."""
+    """The current [A] at which the model's own static map (its cubic term and slot
+    included: no closed-form inverse) first reaches ``target_pa``, bracketed on a grid of
+    the valve's range (inf: it never does)."""
     from landing_gear_sim.model import elements as el  # numba: loaded for a bent map only
 
     p = params.vector()
 
-    def error(current_a: np.ndarray | float) -> np.ndarray | float:
-        return el.valve_static_pressure(p, current_a) - target_pa
+    def error(current_a: float) -> float:
+        return float(el.valve_static_pressure(p, current_a)) - target_pa
 
     grid = np.linspace(params.number(K.ACTUATOR_DEADBAND_CURRENT_A),
                        params.number(K.ACTUATOR_MAX_CURRENT_A), 1001)
-    above = np.flatnonzero(np.asarray(error(grid)) >= 0.0)
+    above = np.flatnonzero(np.array([error(c) for c in grid]) >= 0.0)
     if above.size == 0:
         return math.inf
     if above[0] == 0:

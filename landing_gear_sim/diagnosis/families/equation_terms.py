@@ -178,8 +178,9 @@ class FlywheelTerms(EquationTerms):
     library = eq.FLYWHEEL
     free = (K.FLYWHEEL_INERTIA_KG_M2, K.DRAG_COEFF_N_S2_PER_M2)
     channels = ("flywheel_speed_rad_s", "wheel_speed_rad_s")
+    # drawn in the flywheel's named slot (F₀ sgn v), found in its generic one
     hidden = (_hidden("flywheel_bearing", eq.FLYWHEEL, K.FLYWHEEL_EXTRA_FORCE_N,
-                      (150.0, 400.0)),)
+                      (150.0, 400.0), "sgn v"),)
 
 
 class LoadingTerms(EquationTerms):
@@ -213,8 +214,9 @@ class ValveTerms(EquationTerms):
     channels = PRESSURE
     runs = (RunKind.ACTUATOR_RAMP,)  # where the map lives: A(s) pulled k3 31 % off once
     held_out = BRAKE_RUNS
+    # drawn in the map's named term (k3 e³), found in its generic slot
     hidden = (_hidden("valve_map_bend", eq.VALVE, K.ACTUATOR_EXTRA_MAP_PA_PER_A3,
-                      (-4e6, -1.5e6)),)
+                      (-4e6, -1.5e6), "e³"),)
 
 
 class FxChannelTerms(EquationTerms):

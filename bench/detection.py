@@ -23,9 +23,9 @@ another rate, a counting encoder, a noisy quantised current, a dropout; see
 ``landing_gear_sim.calibration.logger``).
 
 Effects no family or slot term is (``OUTSIDE``, issue 41): laws outside every equation's
-library — two kinds per equation with a generic slot (the wheel's, the tyre's, the flywheel's,
-the loading device's, the valve's A(s), the F_x channel's), drawn here through the plant's
-generic slots; right when
+library — two kinds per equation with a generic slot (the valve's static map and A(s), the
+wheel's, the tyre's, the flywheel's, the loading device's, the F_x channel's), drawn here
+through the plant's generic slots; right when
 discovered in the equation with a held-out gain (no value: no term of the library is the
 law). ``--causes`` names them like the others.
 
@@ -175,6 +175,14 @@ OUTSIDE: dict[str, tuple[str, Draw]] = {
     # eddy currents that grow with the root of the rim's speed: √v (160-460 N at 30-60 m/s)
     "flywheel_eddy_root": ("flywheel", _slot(K.FLYWHEEL_TERMS, basis.factor_code(
         basis.SPEED, basis.SIGNED_ROOT), (30.0, 60.0))),
+    # a map that bends progressively, as the fourth and the fifth power of the current
+    # beyond the dead-band: e⁴, e⁵ (1.3-3.5 bar at 0.9 A)
+    "map_fourth_power": ("valve", _slot(K.MAP_TERMS, _product(
+        (basis.VALVE_CURRENT, basis.SQUARE), (basis.VALVE_CURRENT, basis.SQUARE)),
+        (-4e6, -2e6))),
+    "map_fifth_power": ("valve", _slot(K.MAP_TERMS, _product(
+        (basis.VALVE_CURRENT, basis.SQUARE), (basis.VALVE_CURRENT, basis.CUBE)),
+        (-6e6, -3e6))),
     # a valve that opens faster than it closes: [Ṗ > 1 bar/s]·ΔP in A(s)
     "valve_rising_stiffer": ("valve", _slot(K.VALVE_TERMS, _product(
         (basis.PRESSURE_RATE, basis.STEP), (basis.VALVE_ERROR, basis.IDENTITY)), (0.4, 0.8))),

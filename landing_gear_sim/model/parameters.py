@@ -210,10 +210,8 @@ SPECS: tuple[ParamSpec, ...] = (
                  "sum c_k phi_k"),
     *_slot_terms(K.VALVE_TERMS, "Pa", "the valve's dynamics A(s): P'' = w_n^2 (mu P_static "
                  "+ sum c_k phi_k - P) - 2 zeta w_n P'"),
-    *_slot_terms(K.FLYWHEEL_TERMS, "N", "the flywheel's momentum balance: m_f dv/dt = -F_x - "
-                 "alpha_d v^2 - F0 sgn v - F1 v - sum c_k phi_k"),
-    *_slot_terms(K.MAP_TERMS, "Pa", "the valve's static map: P_static = k1 e + k2 e^2 + k3 e^3 "
-                 "+ sum c_k phi_k(e), e = I - I0, saturated"),
+    *_slot_terms(K.FLYWHEEL_TERMS, "N", "m_f dv/dt = -F_x - alpha_d v^2 - ... - sum c_k phi_k"),
+    *_slot_terms(K.MAP_TERMS, "Pa", "P_static = k1 e + k2 e^2 + ... + sum c_k phi_k(e)"),
 )
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}

@@ -24,10 +24,9 @@ another rate, a counting encoder, a noisy quantised current, a dropout; see
 
 Effects no family or slot term is (``OUTSIDE``, issue 41): laws outside every equation's
 library — two kinds per equation with a generic slot (the valve's static map and A(s), the
-wheel's, the tyre's, the flywheel's, the loading device's, the F_x channel's), drawn here
-through the plant's generic slots; right when
-discovered in the equation with a held-out gain (no value: no term of the library is the
-law). ``--causes`` names them like the others.
+wheel's, the tyre's, the flywheel's, the loading device's, the F_x and pressure channels'),
+drawn here through the plant's generic slots; right when discovered in the equation with a
+held-out gain (no value: no term of the library is the law). ``--causes`` names them like the others.
 
 Data the project did not make: the campaigns under ``../shared/data/independent/`` (or
 ``--independent DIR``; skipped when absent), judged against their ``truth.json``
@@ -189,6 +188,14 @@ OUTSIDE: dict[str, tuple[str, Draw]] = {
     # a second stage that opens beyond half a bar of error: ΔP through a dead zone in A(s)
     "valve_second_stage": ("valve", _slot(K.VALVE_TERMS, basis.factor_code(
         basis.VALVE_ERROR, basis.DEAD_ZONE), (0.3, 0.6))),
+    # a pressure transducer whose zero drifts faster as it warms: t·√t (0.6-1.8 bar at 20 s)
+    "pressure_drift_rising": ("pressure channel", _slot(K.PRESSURE_TERMS, _product(
+        (basis.RUN_TIME, basis.IDENTITY), (basis.RUN_TIME, basis.SIGNED_ROOT)),
+        (700.0, 2000.0))),
+    # a transducer whose gain drifts as the root of the time: P·√t (2-4 % at 20 s)
+    "pressure_gain_root": ("pressure channel", _slot(K.PRESSURE_TERMS, _product(
+        (basis.PRESSURE, basis.IDENTITY), (basis.RUN_TIME, basis.SIGNED_ROOT)),
+        (0.0045, 0.009))),
     # a load cell's zero that drifts in proportion to the load it carries: √t·F_z
     "fx_drift_load": ("F_x channel", _slot(K.FX_TERMS, _product(
         (basis.RUN_TIME, basis.SIGNED_ROOT), (basis.LOAD, basis.IDENTITY)), (1e-3, 3e-3))),

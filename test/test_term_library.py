@@ -103,7 +103,8 @@ def test_a_term_names_its_unit_and_its_coefficients():
 
 
 def test_each_library_composes_only_the_signals_its_equation_sees_in_the_plant():
-    for library in (eq.WHEEL, eq.TYRE, eq.LOADING, eq.FLYWHEEL, eq.VALVE):
+    for library in (eq.WHEEL, eq.TYRE, eq.LOADING, eq.FLYWHEEL, eq.VALVE,
+                    eq.PRESSURE_CHANNEL):
         assert library.slot is not None
         signals = {f // basis.FACTOR for t in library.terms if t.code is not None
                    for f in basis.factors(t.code)}
@@ -123,7 +124,7 @@ def test_a_slot_of_codes_with_zero_coefficients_is_todays_arithmetic_to_the_bit(
              (basis.factor_code(basis.SLIP, basis.CUBE), 0.0)]
     filled = reference
     for slot in (Slot.WHEEL, Slot.TYRE, Slot.LOADING, Slot.VALVE, Slot.FLYWHEEL,
-                 Slot.STATIC_MAP):
+                 Slot.STATIC_MAP, Slot.PRESSURE_CHANNEL):
         filled = _with_terms(filled, slot, codes)
     scenario = sc.constant_pressure_test(reference, 30e5)
     plain, empty = simulate(reference, scenario), simulate(filled, scenario)
@@ -319,6 +320,33 @@ def test_the_f_x_channel_reads_its_slot_and_its_true_value_takes_it_off(referenc
                           force)  # no term: the reading as before, to the bit
 
 
+def test_the_pressure_channel_reads_its_slot_and_its_true_value_takes_it_off(reference):
+    drift = basis.factor_code(basis.RUN_TIME, basis.IDENTITY)
+    bend = basis.factor_code(basis.PRESSURE, basis.SIGNED_SQUARE)
+    drifting = _with_terms(reference, Slot.PRESSURE_CHANNEL, [(drift, 5e3), (bend, 1e-8)])
+    sensors = SensorModel.of(drifting)
+    time = np.linspace(0.0, 10.0, 11)
+    pressure = np.linspace(0.0, 40e5, 11)
+    read = sensors.pressure_channel(time, pressure)
+    assert read - pressure == pytest.approx(5e3 * time + 1e-8 * pressure ** 2)
+    assert sensors.true_pressure(read, time) == pytest.approx(pressure, rel=1e-9, abs=1e-3)
+    assert np.array_equal(SensorModel.of(reference).pressure_channel(time, pressure),
+                          pressure)  # no term: the reading as before, to the bit
+
+
+def test_a_pressure_transducer_that_drifts_is_found_in_the_pressure_channel_not_the_wheel(
+        reference, tmp_path):
+    """Issue 41: a pressure channel drifting 0.05 bar/s was named a wheel term
+    (`−14 N m·sgn ω + 0.00305·F_z − …`, held out −608) with the valve left unexplained: the
+    channel had no equation. The drift is drawn here, through the channel's slot; the wheel
+    and the valve both read the channel, so both carry it."""
+    rate = float(np.random.default_rng(420).uniform(3e3, 8e3))
+    result = _diagnosed(reference, tmp_path, 420, Slot.PRESSURE_CHANNEL, [
+        (basis.factor_code(basis.RUN_TIME, basis.IDENTITY), rate)])
+    finding = _first(result, "pressure channel")
+    assert finding.term.startswith("P_read = P")
+
+
 def test_a_load_cell_that_drifts_is_discovered_in_the_f_x_channel_not_the_wheel(reference,
                                                                               tmp_path):
     """U06's failure (a zero drifting 40 N/s named a wheel bearing): a drift drawn here; the
@@ -407,7 +435,7 @@ def test_the_diagnosis_contract_lists_each_generic_slots_library_as_composed():
     labels = {eq.VALVE_DYNAMICS: "valve (A(s), `diagnosis/valve_library.py`)",
               eq.VALVE: "valve (static map)"}
     for library in (eq.WHEEL, eq.TYRE, eq.LOADING, eq.FX_CHANNEL, eq.VALVE_DYNAMICS,
-                    eq.FLYWHEEL, eq.VALVE):
+                    eq.FLYWHEEL, eq.VALVE, eq.PRESSURE_CHANNEL):
         row = rows[labels.get(library, str(library.equation))]
         symbols = {basis.SIGNALS[f // basis.FACTOR][0] for t in library.terms
                    for f in basis.factors(t.code or 0)}

@@ -49,7 +49,7 @@ def fit_static_map(runs: Sequence[Run], p: RigParameters) -> list[Estimate]:
     map's k3 and slot of ``p`` (read around, as the other calibrations read around
     theirs)."""
     current = np.concatenate([r.current_a for r in runs])
-    pressure = np.concatenate([r.pressure_pa for r in runs])
+    pressure = np.concatenate([_true_pressure(r, p) for r in runs])
     return _fit_map(current, pressure, p, STATIC_MAP, tuple(r.name for r in runs),
                     "static-map least squares")
 
@@ -60,21 +60,22 @@ MIN_HELD_SAMPLES = 20  # a hold's settled part shorter than this is no level
 
 def held_levels(runs: Sequence[ClassifiedRun], p: RigParameters
                 ) -> tuple[np.ndarray, np.ndarray]:
-    """The settled samples of the runs' held commands: (current [A], pressure [Pa]). A
-    hold's samples count from its later half, and from SETTLED_TIME_CONSTANTS of the
-    datasheet's A(s) after its step (a slow valve's delay is in neither)."""
+    """The settled samples of the runs' held commands: (current [A], the pressure behind the
+    channel [Pa]). A hold's samples count from its later half, and from
+    SETTLED_TIME_CONSTANTS of the datasheet's A(s) after its step (a slow valve's delay is
+    in neither)."""
     settle_s = SETTLED_TIME_CONSTANTS / (
         2 * math.pi * p.number(K.ACTUATOR_NATURAL_FREQUENCY_HZ)
         * p.number(K.ACTUATOR_DAMPING_RATIO))
     currents, pressures = [], []
     for run in runs:
-        command = run.command_a
+        command, true = run.command_a, _true_pressure(run, p)
         edges = np.concatenate([[0], np.flatnonzero(np.diff(command)) + 1, [command.size]])
         for first, end in itertools.pairwise(edges.tolist()):
             start = first + max(round(settle_s * run.rate_hz), (end - first) // 2)
             if end - start >= MIN_HELD_SAMPLES:
                 currents.append(command[start:end])
-                pressures.append(run.pressure_pa[start:end])
+                pressures.append(true[start:end])
     if not currents:
         return np.zeros(0), np.zeros(0)
     return np.concatenate(currents), np.concatenate(pressures)
@@ -96,11 +97,16 @@ def fit_map_to_holds(runs: Sequence[ClassifiedRun], p: RigParameters) -> list[Es
                     f"settled pressures of {levels.size} held commands")
 
 
-def _fit_map(current: np.ndarray, pressure_measured: np.ndarray, p: RigParameters,
+def _true_pressure(run: Run, p: RigParameters) -> np.ndarray:
+    """The pressure behind ``run``'s channel as ``p``'s transducer reads it [Pa]."""
+    return np.asarray(SensorModel.of(p).true_pressure(run.pressure_pa,
+                                                      run.time_s - run.time_s[0]))
+
+
+def _fit_map(current: np.ndarray, pressure: np.ndarray, p: RigParameters,
              keys: Sequence[str], names: tuple[str, ...], method: str) -> list[Estimate]:
-    """The map's ``keys`` (of STATIC_MAP) by least squares on (current, pressure) samples,
-    the others kept at ``p``'s."""
-    pressure = SensorModel.of(p).true_pressure(pressure_measured)
+    """The map's ``keys`` (of STATIC_MAP) by least squares on (current, true pressure)
+    samples, the others kept at ``p``'s."""
     max_current, k3 = (p.number(k) for k in (K.ACTUATOR_MAX_CURRENT_A,
                                              K.ACTUATOR_EXTRA_MAP_PA_PER_A3))
     values = np.array([p.number(k) for k in STATIC_MAP])

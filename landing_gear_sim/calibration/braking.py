@@ -77,7 +77,7 @@ def prepare(run: ClassifiedRun, p: RigParameters) -> Braking:
         run=run, time_s=run.time_s - run.time_s[0],
         speed_m_s=rim_speed_m_s(p, lowpass(run.flywheel_speed_rad_s, rate)),
         wheel=wheel, wheel_rate=np.gradient(wheel, 1.0 / rate),
-        pressure=lowpass(sensors.true_pressure(run.pressure_pa), rate),
+        pressure=lowpass(sensors.true_pressure(run.pressure_pa, run_time_s(run)), rate),
         load=lowpass(run.vertical_load_n, rate),
         force=lowpass(sensors.true_longitudinal(run.longitudinal_force_n,
                                                 run.vertical_load_n, run_time_s(run)), rate),

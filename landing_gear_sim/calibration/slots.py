@@ -32,6 +32,7 @@ class Slot(str, enum.Enum):
     VALVE = "actuator"
     FLYWHEEL = "flywheel"
     STATIC_MAP = "actuator_map"
+    PRESSURE_CHANNEL = "sensors_p"
 
     @property
     def keys(self) -> tuple[tuple[str, str], ...]:
@@ -39,7 +40,7 @@ class Slot(str, enum.Enum):
         return {"wheel": K.WHEEL_TERMS, "friction": K.TYRE_TERMS,
                 "loading": K.LOADING_TERMS, "sensors": K.FX_TERMS,
                 "actuator": K.VALVE_TERMS, "flywheel": K.FLYWHEEL_TERMS,
-                "actuator_map": K.MAP_TERMS}[self.value]
+                "actuator_map": K.MAP_TERMS, "sensors_p": K.PRESSURE_TERMS}[self.value]
 
     def value_of(self, params: RigParameters, measured: np.ndarray) -> np.ndarray:
         """The slot of ``params`` at each row of ``measured`` (:func:`signals`)."""
@@ -61,6 +62,7 @@ SEES: dict[Slot, tuple[int, ...]] = {
     Slot.VALVE: (basis.PRESSURE, basis.PRESSURE_RATE, basis.VALVE_ERROR),
     Slot.FLYWHEEL: (basis.SPEED, basis.LOAD),
     Slot.STATIC_MAP: (basis.VALVE_CURRENT,),
+    Slot.PRESSURE_CHANNEL: (basis.PRESSURE, basis.RUN_TIME),
 }
 """The signals each equation's slot sees in the plant (``model.elements``)."""
 

@@ -230,7 +230,8 @@ def _zero_current(run: ClassifiedRun, params: RigParameters) -> Check | None:
     off = ~commanded(run.current_a, run.rate_hz)
     samples = max(1, round(SETTLED_S * run.rate_hz))
     settled = np.convolve(off, np.ones(samples), mode="full")[:off.size] >= samples
-    pressure = SensorModel.of(params).true_pressure(run.pressure_pa[settled])
+    pressure = SensorModel.of(params).true_pressure(run.pressure_pa[settled],
+                                                    (run.time_s - run.time_s[0])[settled])
     return _mean_check(Relation.ZERO_CURRENT, run.name, "current off", pressure,
                        PRESSURE_FLOOR_PA, "Pa", run.rate_hz)
 

@@ -37,6 +37,7 @@ class Relation(str, enum.Enum):
     TYRE_LAW = "tyre follows its friction curve"
     FX_CHANNEL = "F_x channel reads F_x where it is known"
     VALVE_DYNAMICS = "valve follows A(s) between its levels"
+    PRESSURE_READING = "brake torque follows the pressure read, whenever read"
 
     def __str__(self) -> str:
         return self.value

@@ -38,7 +38,7 @@ class Settled:
     """An actuator run under a model, (n,) arrays: the current the valve was fed [A], the
     model's pressure [Pa] and the measured one's excess over it as its channel reads it
     [Pa], which way the current last moved (±1, 0: not yet), and the settled samples
-    (mask); the run's rate [Hz]."""
+    (mask); the run's rate [Hz] and the time since its first sample [s]."""
 
     current_a: np.ndarray
     model_pa: np.ndarray
@@ -46,6 +46,7 @@ class Settled:
     direction: np.ndarray
     settled: np.ndarray
     rate_hz: float
+    time_s: np.ndarray
 
 
 def settled_valve(run: ClassifiedRun, params: RigParameters) -> Settled | None:
@@ -64,7 +65,7 @@ def settled_valve(run: ClassifiedRun, params: RigParameters) -> Settled | None:
     band = (model > 2 * PRESSURE_FLOOR_PA) & (model < 0.9 * params.number(
         K.ACTUATOR_MAX_PRESSURE_PA))
     return Settled(current, model, residual, np.sign(change[last]), slow & band,
-                   run.rate_hz)
+                   run.rate_hz, run.time_s - run.time_s[0])
 
 
 def _unreadable(run: ClassifiedRun, noise_a: float) -> bool:

@@ -142,7 +142,7 @@ class PlantBlock:
         return SensorSample(
             step=self.step_index, time_s=float(row[0]),
             pressure_pa=float(sensors.pressure(self._pressure_history.read(row[0], row[2]),
-                                               rng)),
+                                               rng, row[0])),
             wheel_speed_rad_s=float(sensors.speed(self._wheel_read(row[0], row[3]), rng)),
             flywheel_speed_rad_s=float(sensors.speed(
                 quantities.flywheel_speed_rad_s(self._params, row[4]), rng)),

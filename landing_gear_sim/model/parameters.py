@@ -61,8 +61,7 @@ def _slot(key: str, unit: str, description: str) -> ParamSpec:
 def _slot_terms(keys: tuple[tuple[str, str], ...], unit: str, law: str
                 ) -> tuple[ParamSpec, ...]:
     """An equation's generic slot (issue 41, ``model.basis``): per term the code of its basis
-    function (a whole number) and its coefficient, in the equation's unit per the basis
-    function's."""
+    function (a whole number) and its coefficient, in the equation's unit per φ's."""
     return tuple(spec for code, coeff in keys for spec in (
         ParamSpec(code, "-", f"code of a basis function phi_k of {law} (model.basis: one or "
                   "two factors, each a signal through a shape)", default=0.0),
@@ -212,6 +211,7 @@ SPECS: tuple[ParamSpec, ...] = (
                  "+ sum c_k phi_k - P) - 2 zeta w_n P'"),
     *_slot_terms(K.FLYWHEEL_TERMS, "N", "m_f dv/dt = -F_x - alpha_d v^2 - ... - sum c_k phi_k"),
     *_slot_terms(K.MAP_TERMS, "Pa", "P_static = k1 e + k2 e^2 + ... + sum c_k phi_k(e)"),
+    *_slot_terms(K.PRESSURE_TERMS, "Pa", "P_read = P + offset + sum c_k phi_k(P, t)"),
 )
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}

@@ -1,7 +1,8 @@
 """The rig's sensors: what the transducers read of the true state, written once.
 
 Pressure transducer: the true gauge pressure plus ``sensors.pressure_offset_pa`` when the
-``pressure_sensor_offset`` element is on, plus white noise. Encoders and the load cell:
+``pressure_sensor_offset`` element is on and its generic slot (``sensors.p_term_*``: a
+transducer that drifts or bends), plus white noise. Encoders and the load cell:
 the true value plus white noise; the load cell's longitudinal channel also reads
 ``sensors.crosstalk_fx_per_fz`` of the vertical load (0 on a clean channel), the pressure
 channel may be ``sensors.pressure_delay_s`` and the wheel encoder's
@@ -40,6 +41,7 @@ class SensorModel:
     runout: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0)  # e₁, φ₁ [rad], e₂, φ₂ [rad]
     pressure_delay_s: float = 0.0
     fx_terms: tuple[tuple[float, float], ...] = ()  # the F_x channel's slot: (code, coeff)
+    p_terms: tuple[tuple[float, float], ...] = ()  # the pressure channel's slot
 
     @classmethod
     def of(cls, params: RigParameters) -> SensorModel:
@@ -52,24 +54,26 @@ class SensorModel:
                    params.number(K.SENSORS_WHEEL_SPEED_DELAY_S),
                    tuple(params.number(k) for k in RUNOUT_KEYS),
                    params.number(K.SENSORS_PRESSURE_DELAY_S),
-                   tuple((params.number(code), params.number(coeff))
-                         for code, coeff in K.FX_TERMS if params.number(coeff) != 0.0))
+                   _terms(params, K.FX_TERMS), _terms(params, K.PRESSURE_TERMS))
 
     @property
     def ripples(self) -> bool:
         """Whether the wheel encoder ripples with the wheel's angle."""
         return self.runout[0] != 0.0 or self.runout[2] != 0.0
 
-    def pressure(self, true_pa: Value, rng: np.random.Generator | None = None) -> Value:
+    def pressure(self, true_pa: Value, rng: np.random.Generator | None = None,
+                 time_s: float | np.ndarray = 0.0) -> Value:
         """Transducer reading [Pa, gauge] of the true brake pressure (in step: see
-        :meth:`pressure_channel`)."""
-        return _noisy(true_pa + self.pressure_offset_pa, self.pressure_noise_pa, rng)
+        :meth:`pressure_channel`; ``time_s``: since the run's first sample)."""
+        read = true_pa + self.pressure_offset_pa + self.p_slot(time_s, true_pa)
+        return _noisy(read, self.pressure_noise_pa, rng)
 
     def pressure_channel(self, times_s: np.ndarray, true_pa: np.ndarray,
                          rng: np.random.Generator | None = None) -> np.ndarray:
         """The pressure channel [Pa] of the samples at ``times_s``: the transducer's reading,
         ``pressure_delay_s`` out of step (see :func:`late`)."""
-        return self.pressure(late(times_s, true_pa, self.pressure_delay_s), rng)
+        return self.pressure(late(times_s, true_pa, self.pressure_delay_s), rng,
+                             times_s - times_s[0])
 
     def speed(self, true_rad_s: Value, rng: np.random.Generator | None = None) -> Value:
         """Encoder reading [rad/s]."""
@@ -120,21 +124,49 @@ class SensorModel:
     def fx_slot(self, time_s: float | np.ndarray, vertical_n: Value) -> Value:
         """What the F_x channel's generic slot adds to its reading [N]: Σ c_k φ_k(F_z, t),
         ``model.basis``'s, ``time_s`` since the run's first sample (0: no term)."""
-        if not self.fx_terms:
-            none: Any = 0.0  # a float for arrays too: adds nothing, not even to a NaN's place
-            return none
-        load = np.atleast_1d(np.asarray(vertical_n, dtype=float))
-        signals = np.zeros((load.size, basis.N_SIGNALS))
-        signals[:, basis.LOAD] = load
-        signals[:, basis.RUN_TIME] = np.broadcast_to(time_s, load.shape)
-        total = sum(coeff * basis.term_values(round(code), signals)
-                    for code, coeff in self.fx_terms)
-        added: Any = total if np.ndim(vertical_n) else float(total[0])
-        return added
+        return _slot(self.fx_terms, basis.LOAD, vertical_n, time_s)
 
-    def true_pressure(self, reading_pa: Value) -> Value:
-        """The brake pressure behind a transducer reading (the offset removed) [Pa]."""
-        return reading_pa - self.pressure_offset_pa
+    def p_slot(self, time_s: float | np.ndarray, pressure_pa: Value) -> Value:
+        """What the pressure channel's generic slot adds to its reading [Pa]: Σ c_k φ_k(P, t)
+        (0: no term)."""
+        return _slot(self.p_terms, basis.PRESSURE, pressure_pa, time_s)
+
+    def true_pressure(self, reading_pa: Value, time_s: float | np.ndarray = 0.0) -> Value:
+        """The brake pressure behind a transducer reading (the offset and the slot removed)
+        [Pa]; ``time_s`` since the run's first sample."""
+        pressure = reading_pa - self.pressure_offset_pa
+        if not self.p_terms:
+            return pressure
+        true = pressure
+        for _ in range(PRESSURE_INVERSIONS):  # a slot in P: its reading inverted in turn
+            true = pressure - self.p_slot(time_s, true)
+        return true
+
+
+PRESSURE_INVERSIONS = 10  # each turn leaves the slot's slope in P (a few per cent) of the last
+
+
+def _terms(params: RigParameters, keys: tuple[tuple[str, str], ...]
+           ) -> tuple[tuple[float, float], ...]:
+    """A channel's slot terms that act: (code, coefficient)."""
+    return tuple((params.number(code), params.number(coeff)) for code, coeff in keys
+                 if params.number(coeff) != 0.0)
+
+
+def _slot(terms: tuple[tuple[float, float], ...], signal: int, values: Value,
+          time_s: float | np.ndarray) -> Value:
+    """A channel's slot Σ c_k φ_k at its quantity ``values`` (the basis ``signal``) and the
+    time since the run's first sample (0.0: no term)."""
+    if not terms:
+        none: Any = 0.0  # a float for arrays too: adds nothing, not even to a NaN's place
+        return none
+    quantity = np.atleast_1d(np.asarray(values, dtype=float))
+    signals = np.zeros((quantity.size, basis.N_SIGNALS))
+    signals[:, signal] = quantity
+    signals[:, basis.RUN_TIME] = np.broadcast_to(time_s, quantity.shape)
+    total = sum(coeff * basis.term_values(round(code), signals) for code, coeff in terms)
+    added: Any = total if np.ndim(values) else float(total[0])
+    return added
 
 
 RUNOUT_KEYS = (K.SENSORS_WHEEL_RUNOUT_1, K.SENSORS_WHEEL_RUNOUT_1_PHASE_RAD,

@@ -50,6 +50,7 @@ REGISTRY: tuple[Family, ...] = tuple(sorted((
     equation_terms.WHEEL_FAMILY,
     equation_terms.TYRE_FAMILY,
     equation_terms.FX_CHANNEL_FAMILY,
+    equation_terms.PRESSURE_CHANNEL_FAMILY,
     equation_terms.FLYWHEEL_FAMILY,
     equation_terms.LOADING_FAMILY,
 ), key=lambda f: f.rank))

@@ -246,6 +246,35 @@ class FxChannelTerms(EquationTerms):
                 if (p := self._proposal(evidence, terms)) is not None]
 
 
+class PressureChannelTerms(EquationTerms):
+    """The pressure channel (rank 5, with the channels: what they misread distorts every
+    other relation). A term it keeps must show in the valve's settled pressure too: the
+    valve's runs read the same channel, while a torque on the wheel leaves the valve alone
+    (a drift of 0.05 bar/s had been named a wheel term, the valve left unexplained)."""
+
+    name = "pressure_channel_equation"
+    library = eq.PRESSURE_CHANNEL
+    rank = 5
+    also_breaks = (Relation.WHEEL_BALANCE, Relation.VALVE_DIRECTION)
+    free = (K.BRAKE_GAIN_N_M_PER_PA, *STATIC_MAP)
+    channels = (*PRESSURE, *WHEEL)
+    runs = (RunKind.ACTUATOR_RAMP, *BRAKE_RUNS)
+    hidden = (Hidden("pressure_drift", "pressure channel", lambda rng, datasheet: {
+        K.PRESSURE_TERMS[0][0]: float(basis.factor_code(basis.RUN_TIME, basis.IDENTITY)),
+        K.PRESSURE_TERMS[0][1]: rng.uniform(3e3, 8e3)}, K.PRESSURE_TERMS[0][1], "t",
+        TOLERANCE),)
+
+    def propose(self, evidence: Evidence) -> list[Proposal]:
+        if not any(evidence.violated(r) for r in self.relations):
+            return []
+        campaign = evidence.campaign
+        chosen = [s for s in self.library.select(campaign, evidence.model)
+                  if s.term.code is not None
+                  and eq.valve_reads(campaign, evidence.model, s.term.code, s.value)]
+        return [p for terms in _alternatives(chosen)
+                if (p := self._proposal(evidence, terms)) is not None]
+
+
 def _flywheel_reads(evidence: Evidence, selected: Selected) -> bool:
     """Whether the flywheel's balance carries the channel's term too (at least half of it,
     the same way)."""
@@ -268,3 +297,4 @@ FLYWHEEL_FAMILY = FlywheelTerms()
 LOADING_FAMILY = LoadingTerms()
 TYRE_FAMILY = TyreTerms()
 FX_CHANNEL_FAMILY = FxChannelTerms()
+PRESSURE_CHANNEL_FAMILY = PressureChannelTerms()

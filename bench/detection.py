@@ -26,7 +26,8 @@ Effects no family or slot term is (``OUTSIDE``, issue 41): laws outside every eq
 library — two kinds per equation with a generic slot (the valve's static map and A(s), the
 wheel's, the tyre's, the flywheel's, the loading device's, the F_x and pressure channels'),
 drawn here through the plant's generic slots; right when discovered in the equation with a
-held-out gain (no value: no term of the library is the law). ``--causes`` names them like the others.
+held-out gain (no value: no term of the library is the law). ``--causes`` names them like
+the others.
 
 Data the project did not make: the campaigns under ``../shared/data/independent/`` (or
 ``--independent DIR``; skipped when absent), judged against their ``truth.json``

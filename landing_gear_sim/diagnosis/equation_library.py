@@ -36,15 +36,9 @@ from landing_gear_sim.diagnosis.library import (
     about_run_mean,
     thinned,
 )
+from landing_gear_sim.diagnosis.pressure_channel import PRESSURE_CHANNEL
 from landing_gear_sim.diagnosis.relations import Check, Relation
-from landing_gear_sim.diagnosis.selection import (
-    Rows,
-    Term,
-    basis_terms,
-    ordinary_fit,
-    term_columns,
-)
-from landing_gear_sim.diagnosis.settled_valve import settled_valve
+from landing_gear_sim.diagnosis.selection import Rows, Term, basis_terms, term_columns
 from landing_gear_sim.diagnosis.terms import Shaped, Without
 from landing_gear_sim.diagnosis.valve_library import VALVE, VALVE_DYNAMICS
 from landing_gear_sim.model import basis
@@ -307,73 +301,6 @@ class FxChannelLibrary(Library[tuple[ClassifiedRun, "br.Braking | None"]]):
         return f"F_x,read = F_x{shown} {written}"
 
 
-PRESSURE_TERMS = (Shaped((basis.RUN_TIME,), (basis.IDENTITY, basis.SQUARE, basis.SIGNED_ROOT))
-                  + Shaped((basis.PRESSURE,), (basis.IDENTITY,))
-                  * Shaped((basis.RUN_TIME,), (basis.IDENTITY,)))
-"""The pressure channel's library: a transducer whose zero or gain drifts with the time since
-the run's start. Terms in P alone are not its: the valve's map, calibrated through the
-channel, takes a bend of the reading into its own, and the wheel's torque balance cannot tell
-it from the brake's (a time the valve's runs share is what tells them apart)."""
-
-
-class PressureChannelLibrary(BrakingLibrary):
-    """The pressure channel, P_read = P + offset + Σ c_k φ_k(P, t): a transducer that drifts.
-    The brake feels the true pressure: its error is the wheel's torque balance less the
-    model's torque of the pressure read, where the brake holds steadily, per k_b (a reading
-    c φ too high gives the model k_b c φ too much torque). The same term must show in the
-    valve's settled pressure (:func:`valve_reads`): a wheel's torque does not."""
-
-    equation = Equation.PRESSURE_CHANNEL
-    relation = Relation.PRESSURE_READING
-    unit = "Pa"
-    error_unit = "N m"
-    slot = Slot.PRESSURE_CHANNEL
-    sign = 1.0
-    terms = basis_terms(PRESSURE_TERMS, "Pa")
-
-    def rows(self, b: br.Braking, params: RigParameters,
-             terms: Sequence[Term[br.Braking]] | None = None) -> Rows | None:
-        index = thinned(br.steady_braking_samples(b), b.run.rate_hz)
-        if index.size < 20:
-            return None
-        b = br.in_step(b, params)
-        torque, energy = br.torque_balance(b, params)
-        model = br.model_torque(b, params, energy, index)
-        measured = seen(Slot.PRESSURE_CHANNEL, br.measured_signals(b, params, energy)[index])
-        gain = params.number(K.BRAKE_GAIN_N_M_PER_PA)
-        return Rows(torque[index] - model,
-                    -gain * term_columns(terms or self.terms, b, params, index, measured),
-                    model[:, None], float(np.mean(np.abs(model))))
-
-    def law(self, written: str, params: RigParameters) -> str:
-        return f"P_read = P {written}"
-
-
-def valve_reads(campaign: Campaign, params: RigParameters, code: int, value: float) -> bool:
-    """Whether the actuator runs' settled pressure reads ``value`` of the pressure channel's
-    term ``code`` as the brake's torque does (at least half of it, the same way), beside the
-    map's 1, e, e² (the map, calibrated through the channel, took the rest)."""
-    columns, owned, errors = [], [], []
-    for run in campaign.runs:
-        if run.braking or (v := settled_valve(run, params)) is None:
-            continue
-        index = np.flatnonzero(v.settled)
-        measured = np.zeros((index.size, basis.N_SIGNALS))
-        measured[:, basis.PRESSURE] = run.pressure_pa[index]
-        measured[:, basis.RUN_TIME] = v.time_s[index]
-        excess = el.valve_excess(v.current_a[index],
-                                 params.number(K.ACTUATOR_MAX_CURRENT_A),
-                                 params.number(K.ACTUATOR_DEADBAND_CURRENT_A))
-        columns.append(basis.term_values(code, measured))
-        owned.append(np.column_stack([np.ones_like(excess), excess, excess * excess]))
-        errors.append(v.residual_pa[index])
-    if not columns or sum(c.size for c in columns) < 20:
-        return False
-    coef, _ = ordinary_fit(np.column_stack([np.concatenate(columns), np.vstack(owned)]),
-                           np.concatenate(errors))
-    return bool(coef[0] * value > 0 and abs(coef[0]) >= abs(value) / 2)
-
-
 def momentum_balance(b: br.Braking, params: RigParameters) -> np.ndarray:
     """The flywheel's momentum balance from the run's start, m_f v + ∫(F_x + α_d v² + F_f)
     dt, (n,) [N s]: constant where the model holds, whatever it misses integrated."""
@@ -448,7 +375,6 @@ TYRE = TyreLibrary()
 FLYWHEEL = FlywheelLibrary()
 LOADING = LoadingLibrary()
 FX_CHANNEL = FxChannelLibrary()
-PRESSURE_CHANNEL = PressureChannelLibrary()
 LIBRARIES: tuple[Library[Any], ...] = (VALVE, VALVE_DYNAMICS, WHEEL, TYRE, FLYWHEEL, LOADING,
                                        FX_CHANNEL, PRESSURE_CHANNEL)
 

@@ -36,6 +36,7 @@ from landing_gear_sim.diagnosis.families.base import (
     term_candidate,
 )
 from landing_gear_sim.diagnosis.flywheel_reads import flywheel_reads
+from landing_gear_sim.diagnosis.pressure_channel import valve_reads
 from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.diagnosis.selection import Selected
 from landing_gear_sim.diagnosis.terms import BasisTerm, coefficient_unit, term_of
@@ -270,7 +271,7 @@ class PressureChannelTerms(EquationTerms):
         campaign = evidence.campaign
         chosen = [s for s in self.library.select(campaign, evidence.model)
                   if s.term.code is not None
-                  and eq.valve_reads(campaign, evidence.model, s.term.code, s.value)]
+                  and valve_reads(campaign, evidence.model, s.term.code, s.value)]
         return [p for terms in _alternatives(chosen)
                 if (p := self._proposal(evidence, terms)) is not None]
 

@@ -8,7 +8,8 @@ equations' terms measured) over the samples that carry it: the actuator runs' fo
 every braking run's thinned to the filter's bandwidth for the others. Each equation's
 library is the terms of its generic slot in the plant, basis functions composed with
 :mod:`~.terms` (``actuator.map_term_*``, ``actuator.term_*``, ``wheel.term_*``,
-``friction.term_*``, ``flywheel.term_*``, ``loading.term_*``, ``sensors.fx_term_*``),
+``friction.term_*``, ``flywheel.term_*``, ``loading.term_*``, ``sensors.fx_term_*``,
+``sensors.p_term_*``: :mod:`~.pressure_channel`),
 beside the terms whose coefficients the calibration owns (the map's
 1, e, e²; k_b P in the wheel's; the curve's ϑ; the flywheel's mass and drag; the lift).
 :mod:`~.selection` picks the terms the error needs; the equation's relation
@@ -362,8 +363,8 @@ def channel_noise(values: np.ndarray) -> float:
     """A channel's white noise [its unit]: the robust spread of its second differences
     (a stop's deceleration cancels out of them), or of its first where that is less (an
     encoder's counts, mostly still between steps). First differences alone read a 200 Hz
-    log's wheel channel at 3-9 times its noise, and a tyre's law in speed (11σ) came out
-    `none` under a floor that noise had set."""
+    log's wheel channel at 3-9 times its noise, and set the tyre's floor 5.6 times higher
+    than that noise does."""
     second = np.diff(values, 2)
     robust = 1.4826 * float(np.median(np.abs(second - np.median(second)))) / np.sqrt(6.0)
     first = noise_std(values)

@@ -13,9 +13,10 @@ from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.slots import Slot, seen
 from landing_gear_sim.diagnosis.equations import Equation
 from landing_gear_sim.diagnosis.library import BrakingLibrary, Campaign, thinned
-from landing_gear_sim.diagnosis.relations import Relation
+from landing_gear_sim.diagnosis.relations import Check, Relation
 from landing_gear_sim.diagnosis.selection import (
     Rows,
+    Selected,
     Term,
     basis_terms,
     ordinary_fit,
@@ -65,6 +66,17 @@ class PressureChannelLibrary(BrakingLibrary):
         return Rows(torque[index] - model,
                     -gain * term_columns(terms or self.terms, b, params, index, measured),
                     model[:, None], float(np.mean(np.abs(model))))
+
+    def select(self, campaign: Campaign, params: RigParameters) -> list[Selected]:
+        """The kept terms the valve's settled pressure reads too (:func:`valve_reads`)."""
+        return [s for s in super().select(campaign, params) if s.term.code is not None
+                and valve_reads(campaign, params, s.term.code, s.value)]
+
+    def check(self, campaign: Campaign, params: RigParameters) -> Check | None:
+        """The relation, where a term the error needs is read by the valve too: a torque
+        balance's error in time that the valve does not read is the wheel's (a bearing's
+        torque through a stop), not the channel's."""
+        return super().check(campaign, params) if self.select(campaign, params) else None
 
     def law(self, written: str, params: RigParameters) -> str:
         return f"P_read = P {written}"

@@ -36,7 +36,6 @@ from landing_gear_sim.diagnosis.families.base import (
     term_candidate,
 )
 from landing_gear_sim.diagnosis.flywheel_reads import flywheel_reads
-from landing_gear_sim.diagnosis.pressure_channel import valve_reads
 from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.diagnosis.selection import Selected
 from landing_gear_sim.diagnosis.terms import BasisTerm, coefficient_unit, term_of
@@ -268,10 +267,7 @@ class PressureChannelTerms(EquationTerms):
     def propose(self, evidence: Evidence) -> list[Proposal]:
         if not any(evidence.violated(r) for r in self.relations):
             return []
-        campaign = evidence.campaign
-        chosen = [s for s in self.library.select(campaign, evidence.model)
-                  if s.term.code is not None
-                  and valve_reads(campaign, evidence.model, s.term.code, s.value)]
+        chosen = self.library.select(evidence.campaign, evidence.model)  # the valve reads
         return [p for terms in _alternatives(chosen)
                 if (p := self._proposal(evidence, terms)) is not None]
 

@@ -347,6 +347,22 @@ def test_a_pressure_transducer_that_drifts_is_found_in_the_pressure_channel_not_
     assert finding.term.startswith("P_read = P")
 
 
+def test_a_transducer_drifting_faster_as_it_warms_is_found_in_the_pressure_channel(
+        reference, tmp_path):
+    """Issue 41's own sweep: a drift as t·√t (outside the library) is fitted by t, t² and
+    √t with coefficients of either sign (6.0e3, 1.3e2, −7.0e3), each meaningless alone:
+    the valve must read their sum, and does. (Through a 256-count encoder the same drift is
+    still named a wheel term: see the sweep's numbers.)"""
+    rng = np.random.default_rng(1357)
+    rig = rig_like(reference, rng)
+    law = basis.product_code(basis.factor_code(basis.RUN_TIME, basis.IDENTITY),
+                             basis.factor_code(basis.RUN_TIME, basis.SIGNED_ROOT))
+    rig = _with_terms(rig, Slot.PRESSURE_CHANNEL, [(law, float(rng.uniform(700.0, 2000.0)))])
+    generate_campaign(tmp_path, rig, 1357)
+    result = diagnose(read_campaign(tmp_path).runs, reference)
+    assert _first(result, "pressure channel").term.startswith("P_read = P")
+
+
 def test_a_load_cell_that_drifts_is_discovered_in_the_f_x_channel_not_the_wheel(reference,
                                                                               tmp_path):
     """U06's failure (a zero drifting 40 N/s named a wheel bearing): a drift drawn here; the

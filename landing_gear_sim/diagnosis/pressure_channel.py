@@ -68,9 +68,10 @@ class PressureChannelLibrary(BrakingLibrary):
                     model[:, None], float(np.mean(np.abs(model))))
 
     def select(self, campaign: Campaign, params: RigParameters) -> list[Selected]:
-        """The kept terms the valve's settled pressure reads too (:func:`valve_reads`)."""
-        return [s for s in super().select(campaign, params) if s.term.code is not None
-                and valve_reads(campaign, params, s.term.code, s.value)]
+        """The kept terms, when the valve's settled pressure reads them too
+        (:func:`valve_reads`)."""
+        chosen = super().select(campaign, params)
+        return chosen if chosen and valve_reads(campaign, params, chosen) else []
 
     def check(self, campaign: Campaign, params: RigParameters) -> Check | None:
         """The relation, where a term the error needs is read by the valve too: a torque
@@ -82,10 +83,13 @@ class PressureChannelLibrary(BrakingLibrary):
         return f"P_read = P {written}"
 
 
-def valve_reads(campaign: Campaign, params: RigParameters, code: int, value: float) -> bool:
-    """Whether the actuator runs' settled pressure reads ``value`` of the pressure channel's
-    term ``code`` as the brake's torque does (at least half of it, the same way), beside the
-    map's 1, e, e² (the map, calibrated through the channel, took the rest)."""
+def valve_reads(campaign: Campaign, params: RigParameters, chosen: Sequence[Selected]
+                ) -> bool:
+    """Whether the actuator runs' settled pressure reads the pressure channel's ``chosen``
+    terms, at their values, as the brake's torque does (at least half of their sum, the
+    same way), beside the map's 1, e, e² (the map, calibrated through the channel, took the
+    rest). Their sum, not each: terms alike in time (t, √t, t²) share a drift between them
+    in any proportion."""
     columns, owned, errors = [], [], []
     for run in campaign.runs:
         if run.braking or (v := settled_valve(run, params)) is None:
@@ -97,14 +101,15 @@ def valve_reads(campaign: Campaign, params: RigParameters, code: int, value: flo
         excess = el.valve_excess(v.current_a[index],
                                  params.number(K.ACTUATOR_MAX_CURRENT_A),
                                  params.number(K.ACTUATOR_DEADBAND_CURRENT_A))
-        columns.append(basis.term_values(code, measured))
+        columns.append(np.sum([s.value * basis.term_values(s.term.code or 0, measured)
+                               for s in chosen], axis=0))
         owned.append(np.column_stack([np.ones_like(excess), excess, excess * excess]))
         errors.append(v.residual_pa[index])
     if not columns or sum(c.size for c in columns) < 20:
         return False
     coef, _ = ordinary_fit(np.column_stack([np.concatenate(columns), np.vstack(owned)]),
                            np.concatenate(errors))
-    return bool(coef[0] * value > 0 and abs(coef[0]) >= abs(value) / 2)
+    return bool(coef[0] >= 0.5)
 
 
 PRESSURE_CHANNEL = PressureChannelLibrary()

@@ -36,6 +36,7 @@ from landing_gear_sim.diagnosis.library import (
     Library,
     about_run_mean,
     thinned,
+    torque_rows,
 )
 from landing_gear_sim.diagnosis.pressure_channel import PRESSURE_CHANNEL
 from landing_gear_sim.diagnosis.relations import Check, Relation
@@ -82,13 +83,7 @@ class WheelLibrary(BrakingLibrary):
         index = thinned(br.steady_braking_samples(b) | br.free_rolling(b), b.run.rate_hz)
         if index.size < 20:
             return None
-        b = br.in_step(b, params)  # a late pressure channel's error is its own family's
-        torque, energy = br.torque_balance(b, params)
-        model = br.model_torque(b, params, energy, index)
-        measured = seen(Slot.WHEEL, br.measured_signals(b, params, energy)[index])
-        return Rows(torque[index] - model,
-                    term_columns(terms or self.terms, b, params, index, measured),
-                    model[:, None], float(np.mean(np.abs(model))))
+        return torque_rows(b, params, index, Slot.WHEEL, terms or self.terms)
 
     def law(self, written: str, params: RigParameters) -> str:
         return f"J_w·ω̇ = r·F_x − T_b {written}"

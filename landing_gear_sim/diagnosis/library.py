@@ -18,7 +18,7 @@ import numpy as np
 
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun
-from landing_gear_sim.calibration.slots import Slot
+from landing_gear_sim.calibration.slots import Slot, seen
 from landing_gear_sim.diagnosis.equations import Equation
 from landing_gear_sim.diagnosis.relations import Check, Relation
 from landing_gear_sim.diagnosis.selection import (
@@ -29,6 +29,7 @@ from landing_gear_sim.diagnosis.selection import (
     fit_terms,
     floor_of,
     significant,
+    term_columns,
 )
 from landing_gear_sim.model.parameters import RigParameters
 
@@ -124,3 +125,17 @@ def about_run_mean(error: np.ndarray, terms: np.ndarray, owned: np.ndarray, scal
     start)."""
     return Rows(error - error.mean(), terms - terms.mean(axis=0), owned - owned.mean(axis=0),
                 scale)
+
+
+def torque_rows(b: br.Braking, params: RigParameters, index: np.ndarray, slot: Slot,
+                terms: Sequence[Term[br.Braking]], factor: float = 1.0) -> Rows:
+    """The wheel's torque balance less the model's brake torque at the samples ``index`` of
+    ``b``, regressed on ``terms`` (times ``factor``) beside the model's torque (k_b's share);
+    the equation's scale is the mean brake torque. The pressure is taken in step (a late
+    channel's error is its own family's)."""
+    b = br.in_step(b, params)
+    torque, energy = br.torque_balance(b, params)
+    model = br.model_torque(b, params, energy, index)
+    measured = seen(slot, br.measured_signals(b, params, energy)[index])
+    return Rows(torque[index] - model, factor * term_columns(terms, b, params, index, measured),
+                model[:, None], float(np.mean(np.abs(model))))

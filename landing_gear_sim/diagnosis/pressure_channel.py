@@ -10,9 +10,9 @@ from collections.abc import Sequence
 import numpy as np
 
 from landing_gear_sim.calibration import braking as br
-from landing_gear_sim.calibration.slots import Slot, seen
+from landing_gear_sim.calibration.slots import Slot
 from landing_gear_sim.diagnosis.equations import Equation
-from landing_gear_sim.diagnosis.library import BrakingLibrary, Campaign, thinned
+from landing_gear_sim.diagnosis.library import BrakingLibrary, Campaign, thinned, torque_rows
 from landing_gear_sim.diagnosis.relations import Check, Relation
 from landing_gear_sim.diagnosis.selection import (
     Rows,
@@ -20,7 +20,6 @@ from landing_gear_sim.diagnosis.selection import (
     Term,
     basis_terms,
     ordinary_fit,
-    term_columns,
 )
 from landing_gear_sim.diagnosis.settled_valve import settled_valve
 from landing_gear_sim.diagnosis.terms import Shaped
@@ -58,14 +57,8 @@ class PressureChannelLibrary(BrakingLibrary):
         index = thinned(br.steady_braking_samples(b), b.run.rate_hz)
         if index.size < 20:
             return None
-        b = br.in_step(b, params)
-        torque, energy = br.torque_balance(b, params)
-        model = br.model_torque(b, params, energy, index)
-        measured = seen(Slot.PRESSURE_CHANNEL, br.measured_signals(b, params, energy)[index])
-        gain = params.number(K.BRAKE_GAIN_N_M_PER_PA)
-        return Rows(torque[index] - model,
-                    -gain * term_columns(terms or self.terms, b, params, index, measured),
-                    model[:, None], float(np.mean(np.abs(model))))
+        return torque_rows(b, params, index, Slot.PRESSURE_CHANNEL, terms or self.terms,
+                           -params.number(K.BRAKE_GAIN_N_M_PER_PA))
 
     def select(self, campaign: Campaign, params: RigParameters) -> list[Selected]:
         """The kept terms, when the valve's settled pressure reads them too

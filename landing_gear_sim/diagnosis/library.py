@@ -23,6 +23,7 @@ from landing_gear_sim.diagnosis.equations import Equation
 from landing_gear_sim.diagnosis.relations import Check, Relation
 from landing_gear_sim.diagnosis.selection import (
     MIN_EFFECT,
+    Fitted,
     Rows,
     Selected,
     Term,
@@ -79,22 +80,32 @@ class Library(abc.ABC, Generic[S]):
 
     def select(self, campaign: Campaign, params: RigParameters) -> list[Selected]:
         """The library's terms the equation's error needs under ``params``."""
-        rows = self._rows(campaign, params)
-        fitted = fit_terms(self.terms, rows) if rows else None
-        return fitted.selected if fitted and significant(fitted, rows, self.min_effect) \
-            else []
+        return self._kept(campaign, params, *self._fit(campaign, params))
 
     def check(self, campaign: Campaign, params: RigParameters) -> Check | None:
         """The equation's relation over the campaign: what its terms explain jointly (None:
         no run to tell)."""
-        rows = self._rows(campaign, params)
-        fitted = fit_terms(self.terms, rows) if rows else None
+        return self._check(*self._fit(campaign, params))
+
+    def _kept(self, campaign: Campaign, params: RigParameters, rows: list[Rows],
+              fitted: Fitted | None) -> list[Selected]:
+        """The fitted terms, when they matter jointly (none: they do not)."""
+        return fitted.selected if fitted and significant(fitted, rows, self.min_effect) \
+            else []
+
+    def _check(self, rows: list[Rows], fitted: Fitted | None) -> Check | None:
         if fitted is None or not fitted.selected:
             return None
         named = ", ".join(s.term.name for s in fitted.selected)
         return Check(self.relation, "campaign", f"{self.phase}, {named}", fitted.effect,
                      fitted.effect / max(fitted.z, 1e-12), floor_of(rows, self.min_effect),
                      self.error_unit or self.unit)
+
+    def _fit(self, campaign: Campaign, params: RigParameters
+             ) -> tuple[list[Rows], Fitted | None]:
+        """The error's rows over the campaign and the library fitted to them (None: no row)."""
+        rows = self._rows(campaign, params)
+        return rows, fit_terms(self.terms, rows) if rows else None
 
     def _rows(self, campaign: Campaign, params: RigParameters) -> list[Rows]:
         return [r for s in self.sources(campaign, params)

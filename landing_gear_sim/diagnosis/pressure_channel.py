@@ -15,6 +15,7 @@ from landing_gear_sim.diagnosis.equations import Equation
 from landing_gear_sim.diagnosis.library import BrakingLibrary, Campaign, thinned, torque_rows
 from landing_gear_sim.diagnosis.relations import Check, Relation
 from landing_gear_sim.diagnosis.selection import (
+    Fitted,
     Rows,
     Selected,
     Term,
@@ -60,17 +61,20 @@ class PressureChannelLibrary(BrakingLibrary):
         return torque_rows(b, params, index, Slot.PRESSURE_CHANNEL, terms or self.terms,
                            -params.number(K.BRAKE_GAIN_N_M_PER_PA))
 
-    def select(self, campaign: Campaign, params: RigParameters) -> list[Selected]:
+    def _kept(self, campaign: Campaign, params: RigParameters, rows: list[Rows],
+              fitted: Fitted | None) -> list[Selected]:
         """The kept terms, when the valve's settled pressure reads them too
         (:func:`valve_reads`)."""
-        chosen = super().select(campaign, params)
+        chosen = super()._kept(campaign, params, rows, fitted)
         return chosen if chosen and valve_reads(campaign, params, chosen) else []
 
     def check(self, campaign: Campaign, params: RigParameters) -> Check | None:
         """The relation, where a term the error needs is read by the valve too: a torque
         balance's error in time that the valve does not read is the wheel's (a bearing's
-        torque through a stop), not the channel's."""
-        return super().check(campaign, params) if self.select(campaign, params) else None
+        torque through a stop), not the channel's. The rows are read and fitted once."""
+        rows, fitted = self._fit(campaign, params)
+        return self._check(rows, fitted) if self._kept(campaign, params, rows, fitted) \
+            else None
 
     def law(self, written: str, params: RigParameters) -> str:
         return f"P_read = P {written}"

@@ -227,7 +227,7 @@ def _absorbed(b: Braking, torque: np.ndarray) -> np.ndarray:
 
 def flywheel_extra(b: Braking, p: RigParameters) -> np.ndarray:
     """The force of the flywheel equation's slots at each sample of ``b`` [N], opposing the
-    motion beside the drag (the plant's ``flywheel_extra``, at the measured speed and load)."""
+    motion beside the drag (the plant's ``flywheel_slot``, at the measured speed and load)."""
     named = flywheel_extra_force(p.vector(), b.speed_m_s)
     if not Slot.FLYWHEEL.occupied(p):
         return named

@@ -321,14 +321,19 @@ def valve_map(current_a, max_current_a, deadband_a, k1_pa_per_a, k2_pa_per_a2, k
 
 
 @njit(cache=True)
+def map_slot(p, current_a):
+    """The static map's generic slot [Pa] at ``current_a`` [A]: Σ c_k φ_k(e), e = I − I0
+    (a call, not inlined, because the step only pays for it when a term is set)."""
+    excess = valve_excess(current_a, p[MAX_CURRENT], p[DEADBAND])
+    return basis.slot_value(p, MAP_SLOT, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+                                          0.0, 0.0, excess))
+
+
+@njit(cache=True)
 def valve_static_pressure(p, current_a):
     """The valve's static-map pressure [Pa] of the parameter set at ``current_a`` [A] (a
     float)."""
-    extra = 0.0
-    if basis.slot_acts(p, MAP_SLOT):
-        excess = valve_excess(current_a, p[MAX_CURRENT], p[DEADBAND])
-        extra = basis.slot_value(p, MAP_SLOT, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
-                                               0.0, 0.0, excess))
+    extra = map_slot(p, current_a) if basis.slot_acts(p, MAP_SLOT) else 0.0
     return valve_map(current_a, p[MAX_CURRENT], p[DEADBAND], p[MAP_K1], p[MAP_K2],
                      p[MAP_EXTRA_3], p[MAX_PRESSURE], extra)
 

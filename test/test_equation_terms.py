@@ -195,6 +195,30 @@ def test_a_later_family_is_tried_when_the_accepted_term_leaves_its_relation_viol
         assert tried == names
 
 
+def test_a_held_out_gain_on_other_runs_and_channels_does_not_outweigh_the_relations():
+    """A pressure transducer's drift through a 256-count encoder: the channel's term gained
+    1054 on the pressure of three runs and left two relations violated, a wheel term gained
+    7074 on the wheel speed of three others and left three; the wheel term had won on its
+    6.7 times larger gain. Gains measured alike still decide."""
+    from landing_gear_sim.diagnosis import discovered as d
+
+    def scored(gain: float, runs: tuple[str, ...], channels: tuple[str, ...]):
+        finding = type("F", (), {"accepted": True, "held_out": -gain, "checked_on": runs,
+                                 "delta_bic": -100.0})()
+        candidate = type("C", (), {"channels": channels})()
+        return type("S", (), {"finding": finding, "fit": type("Fit", (), {
+            "candidate": candidate})()})()
+
+    channel = scored(1054.0, ("a", "b", "c"), ("pressure_pa", "wheel_speed_rad_s"))
+    wheel = scored(7074.0, ("d", "e", "f"), ("wheel_speed_rad_s",))
+    left = {id(channel): [1, 2], id(wheel): [1, 2, 3]}
+    violated = lambda s: left[id(s)]  # noqa: E731
+    assert d._better(channel, wheel, violated) is channel
+    alike = scored(7074.0, ("a", "b", "c"), ("pressure_pa", "wheel_speed_rad_s"))
+    left[id(alike)] = [1, 2, 3]
+    assert d._better(channel, alike, violated) is alike
+
+
 def test_the_flywheel_tells_a_load_cell_crosstalk_from_a_bearing_torque(reference, tmp_path):
     """Both make the F_x channel read a force in free rolling; only the crosstalk is a force
     the flywheel does not feel."""

@@ -81,13 +81,14 @@ def _better(first: Scored | None, second: Scored | None,
     the better predictor (a drift through a campaign in rising pressure order fits a
     pressure law nearly as well in sample: ΔBIC −94 against −115 once, held out −144
     against −101; a valve's play, held out +5093, once lost to a spool's friction, +136,
-    that left one relation fewer violated); of two not accepted, the lower ΔBIC."""
+    that left one relation fewer violated); of two not accepted, the lower ΔBIC. Gains
+    outweigh relations only when measured alike (:func:`_alike`)."""
     if first is None or second is None:
         return first or second
     both = first.finding.accepted and second.finding.accepted
     def gain(s: Scored) -> float:
         return -s.finding.held_out if s.finding.held_out is not None else -math.inf
-    if both and max(gain(first), gain(second)) > PREDICTS_BETTER * max(
+    if both and _alike(first, second) and max(gain(first), gain(second)) > PREDICTS_BETTER * max(
             min(gain(first), gain(second)), 0.0):
         return max(first, second, key=gain)
     def rank(s: Scored) -> tuple[bool, int, float]:
@@ -95,6 +96,15 @@ def _better(first: Scored | None, second: Scored | None,
             return not s.finding.accepted, 0, s.finding.delta_bic or 0.0
         return False, len(violated(s)), -gain(s)
     return min(first, second, key=rank)
+
+
+def _alike(first: Scored, second: Scored) -> bool:
+    """Whether two held-out gains were measured on the same runs and channels: a pressure
+    transducer's drift, its channel's term gaining 1054 on the pressure of three runs, lost
+    to a wheel term gaining 7074 on the wheel speed of three others, which left three
+    relations violated against the channel's two."""
+    return (set(first.finding.checked_on) == set(second.finding.checked_on)
+            and set(first.fit.candidate.channels) == set(second.fit.candidate.channels))
 
 
 def _violated_under(scored: Scored, runs: Sequence[ClassifiedRun]) -> list[Check]:

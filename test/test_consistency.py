@@ -21,6 +21,7 @@ from landing_gear_sim.diagnosis.consistency import (
     WHEEL_ANGLE,
     check_campaign,
     unchecked_relations,
+    under_floor,
 )
 from landing_gear_sim.diagnosis.diagnose import diagnose
 from landing_gear_sim.diagnosis.families import HIDDEN
@@ -317,3 +318,17 @@ def test_a_brake_that_wears_from_run_to_run_breaks_its_constancy(reference, tmp_
     assert drift.violated, drift.describe()
     expected = (1 - wear) ** (len(braking) - 1) - 1
     assert drift.deviation == pytest.approx(expected, rel=0.25)
+
+
+def test_a_deviation_beyond_its_sigma_but_under_its_floor_is_said_not_ruled_out():
+    """A tyre whose μ grows as μ_B·v² (−3.6e-5), logged at 200 Hz, deviated by 0.027 at 11σ
+    under a floor of 0.046 (what the log's slip noise makes of μ) and came out `none` with
+    nothing said; a deviation within its σ says nothing."""
+    from landing_gear_sim.diagnosis.relations import Check, Relation
+
+    tyre = Check(Relation.TYRE_LAW, "campaign", "braking runs, μ_B·v", 0.02703, 0.0024, 0.0455,
+                 "-")
+    quiet = dataclasses.replace(tyre, relation=Relation.FREE_ROLLING, deviation=0.01)
+    (said,) = under_floor([tyre, quiet])
+    assert "tyre follows its friction curve" in said and "11σ" in said and "0.0455" in said
+    assert under_floor([dataclasses.replace(tyre, deviation=0.05)]) == []  # violated: a finding

@@ -39,6 +39,7 @@ from landing_gear_sim.diagnosis.consistency import (
     coarse_channels,
     inconsistent,
     unchecked_relations,
+    under_floor,
 )
 from landing_gear_sim.diagnosis.equations import locate_all
 from landing_gear_sim.diagnosis.findings import Finding, Signature
@@ -217,6 +218,7 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
         # not 'none' (a catalogued effect may hide in what could not be tested), and no
         # 'unexplained' either: an untested candidate may be what the residual shows
         verdict = INCONCLUSIVE
+    problems.extend(under_floor(checks))
     if any(f.cause == "actuator_delay" for f in table):  # the calibration's hint, answered
         problems = [p for p in problems if LATE not in p]
     evidence = [run_evidence(*sims, calibrated)

@@ -20,7 +20,6 @@ from landing_gear_sim.diagnosis.families import HIDDEN, REGISTRY
 from landing_gear_sim.diagnosis.families.equation_terms import EquationTerms
 from landing_gear_sim.diagnosis.flywheel_reads import flywheel_carries
 from landing_gear_sim.diagnosis.relations import Relation
-from landing_gear_sim.model import basis
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model import scenario as sc
@@ -113,26 +112,9 @@ def test_a_clean_campaign_violates_no_equation_and_says_so(reference, tmp_path):
     runs, calibrated = _campaign(reference, tmp_path, 320)
     checks = [c for c in check_campaign(runs, calibrated)
               if c.relation in (Relation.VALVE_MAP, Relation.WHEEL_BALANCE, Relation.TYRE_LAW,
-                                Relation.FLYWHEEL_BALANCE, Relation.LOADING_LAW,
-                                Relation.FX_CHANNEL)]
-    assert len(checks) == 6
+                                Relation.FLYWHEEL_BALANCE, Relation.LOADING_LAW)]
+    assert len(checks) == 5
     assert not [c.describe() for c in checks if c.violated]
-
-
-def test_a_load_cell_drifting_as_the_root_of_time_under_load_breaks_its_channel(
-        reference, tmp_path):
-    """F_x read + 1.16e-3·√t·F_z (outside the channel's library): 140 N at 20-95σ under a
-    floor of 160 N (half a per cent of the scale) had left the relation unbroken, and the
-    drift was named a wheel term; the nulls' checks read 2-8 N."""
-    from landing_gear_sim.diagnosis.consistency import check_campaign
-
-    code = basis.product_code(basis.factor_code(basis.RUN_TIME, basis.SIGNED_ROOT),
-                              basis.factor_code(basis.LOAD, basis.IDENTITY))
-    runs, calibrated = _campaign(reference, tmp_path, 321, {
-        K.FX_TERMS[0][0]: float(code), K.FX_TERMS[0][1]: 1.16e-3})
-    (channel,) = [c for c in check_campaign(runs, calibrated)
-                  if c.relation == Relation.FX_CHANNEL]
-    assert channel.violated, channel.describe()
 
 
 def test_a_known_map_bend_is_read_around_by_the_static_map_fit(reference, tmp_path):

@@ -257,10 +257,6 @@ class FxChannelLibrary(Library[tuple[ClassifiedRun, "br.Braking | None"]]):
     equation = Equation.FX_CHANNEL
     relation = Relation.FX_CHANNEL
     unit = "N"
-    # a quarter per cent of the scale (80 N): a load cell drifting as √t·F_z read 115-145 N
-    # at 20-95σ under the half per cent, and was named a wheel term; the nulls' F_x checks
-    # read 2-8 N, within 1σ
-    min_effect = 0.0025
     phase = "where F_x is known"
     slot = Slot.FX_CHANNEL
     sign = 1.0

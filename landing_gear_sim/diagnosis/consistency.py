@@ -139,12 +139,9 @@ def under_floor(checks: Sequence[Check]) -> list[str]:
     data show them, the diagnosis does not call them violated, and ``none`` does not rule
     out an effect of their size (a tyre's μ_B·v² law logged at 200 Hz read 0.027 at 11σ
     under the 0.046 its slip noise allows, and was said nowhere)."""
-    def unit(c: Check) -> str:
-        return "" if c.unit == "-" else f" {c.unit}"
-
-    return [f"{c.relation} ({c.run}, {c.phase}): {c.deviation:+.4g}{unit(c)} at {c.z:.0f}σ "
-            f"lies under its floor {c.floor:.4g}{unit(c)} (the least that matters, or what "
-            "the log's noise makes of it): an effect of this size is not told from that here"
+    return [f"{c.describe()} lies under its floor {c.floor:.4g} {c.unit} (the least that "
+            "matters, or what the log's noise makes of it): an effect of this size is not told "
+            "from that here"
             for c in sorted(checks, key=lambda c: -c.z)
             if c.z > Z_VIOLATED and not c.violated]
 

@@ -31,7 +31,10 @@ MIN_EFFECT = 0.005  # a term's rms effect over the equation's scale: half a per 
 MAX_KEPT = basis.SLOT_TERMS  # terms a slot holds
 SPANNED = 1e-3  # a column this close to the span of those before it adds nothing
 ALIKE = 0.05  # a column this close to one before it alone is that one, as the samples see
-NOISE_FLOOR = 3.0  # times the error the regressors' own noise makes
+# times the error the regressors' own noise makes: nulls read up to 0.87 of it (the tyre
+# through a 256-count encoder, at 25-29σ); at 3 a tyre's μ_B·v² logged at 200 Hz (1.3-1.8)
+# came out `none`
+NOISE_FLOOR = 1.5
 
 S = TypeVar("S")  # what a library reads one run's rows from: a braking run's signals, ...
 

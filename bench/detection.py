@@ -2,7 +2,8 @@
 and the campaigns of an independent simulator.
 
 Run: ``python bench/detection.py [--per-cause N] [--nulls N] [--causes a,b] [--seed S]
-[--logger-realities] [--independent DIR] [--scheduler tcp://HOST:8786] [--workers N]`` (not
+[--logger-realities] [--independent DIR] [--campaigns CAUSE:SEED,...] [--scheduler
+tcp://HOST:8786] [--workers N]`` (not
 part of ``make bench``: ~20-40 s per campaign here, so the default sweep of 3 campaigns per
 cause and family, 5 null campaigns and the ten independent ones takes about 20 minutes on 2
 cores). The campaigns run on Dask, like ``history``: a local cluster
@@ -27,7 +28,9 @@ library — two kinds per equation with a generic slot (the valve's static map a
 wheel's, the tyre's, the flywheel's, the loading device's, the F_x and pressure channels'),
 drawn here through the plant's generic slots; right when discovered in the equation with a
 held-out gain (no value: no term of the library is the law). ``--causes`` names them like
-the others.
+the others. ``--campaigns`` runs given (cause, seed) pairs alone: a seed draws the rig, the
+effect and (with ``--logger-realities``) the logger, so a failure seen in a sweep, or the
+seeds whose logger is 200 Hz, can be run again by themselves.
 
 Data the project did not make: the campaigns under ``../shared/data/independent/`` (or
 ``--independent DIR``; skipped when absent), judged against their ``truth.json``
@@ -421,6 +424,19 @@ def equation_outcomes(rows: list[dict]) -> dict[str, int]:
     return counts
 
 
+def _pairs(text: str) -> list[tuple[str | None, int]]:
+    """``--campaigns``' CAUSE:SEED pairs (none: a null)."""
+    known = {*CASES, *FAMILIES, *OUTSIDE, "none"}
+    pairs = []
+    for item in text.split(","):
+        cause, _, seed = item.partition(":")
+        if cause not in known or not seed.isdigit():
+            raise argparse.ArgumentTypeError(
+                f"{item!r}: not CAUSE:SEED with a cause of --causes or none")
+        pairs.append((None if cause == "none" else cause, int(seed)))
+    return pairs
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--per-cause", type=int, default=3)
@@ -444,12 +460,17 @@ def main() -> None:
                              "data/unseen; skipped when absent)")
     parser.add_argument("--only-independent", action="store_true",
                         help="only the campaigns the project did not make")
+    parser.add_argument("--campaigns", type=_pairs, default=None, metavar="CAUSE:SEED,...",
+                        help="only these campaigns of the own generator (none:SEED a null; "
+                             "e.g. seeds whose random logger is 200 Hz), nothing else")
     args = parser.parse_args()
     plan = [(c, args.seed + 17 * i + j) for i, c in enumerate(args.causes.split(","))
             for j in range(args.per_cause)]
     plan += [(None, args.seed + 900 + j) for j in range(args.nulls)]
     if args.only_independent:
         plan = []
+    if args.campaigns is not None:
+        plan = args.campaigns
     suffix = ("-light" if args.light_runs else "") + ("-logger" if args.logger_realities else "")
     own = [Task(f"{cause or 'none'}-{seed}{suffix}", case_task,
                 (cause, seed, args.light_runs, args.logger_realities)) for cause, seed in plan]
@@ -461,7 +482,9 @@ def main() -> None:
     unseen += [Task(f"datasheet-{folder.name}", datasheet_task, (str(folder),))
                for folder in independent.campaigns(args.unseen)
                if independent.datasheet_of(folder) is not None]
-    if not theirs:
+    if args.campaigns is not None:
+        theirs, unseen = [], []
+    elif not theirs:
         print(f"{args.independent}: no independent campaigns, skipped", file=sys.stderr)
     journal = args.journal or Path("out/detection") / f"seed-{args.seed}{suffix}.jsonl"
     with client(args.scheduler, args.workers) as engine:

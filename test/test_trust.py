@@ -87,6 +87,22 @@ def test_a_null_campaign_read_by_a_counting_encoder_is_none(reference, tmp_path)
     assert result.verdict == "none", [f.evidence for f in result.findings]
 
 
+def test_a_null_logged_at_200_hz_through_a_noisy_adc_is_none_and_says_what_it_cannot_tell(
+        reference, tmp_path):
+    """Issue 41, nulls: a current logged at 200 Hz with 6.7 mA of noise through a 12-bit ADC
+    (fed to the model as logged, or through a 5-sample median) moves the model's pressure by
+    10-20 kPa rms; A(s)'s √ΔP read 12.6 kPa of it at 7σ and the null came out `unexplained
+    (valve)`. A valve's second stage reads the same there (12-35 kPa at 6-16σ): the check
+    still calls for the valve's terms, the scoring judges them, and what is left within the
+    current's noise is said, not reported as structure."""
+    logger = Logger(rate_hz=200.0, current_noise_a=0.00669199, current_adc_bits=12)
+    runs, _ = _campaign(reference, tmp_path, 3066, logger=logger, names=None)
+    result = _consistent(diagnose(runs, reference))
+    assert result.verdict == "none", [f.evidence for f in result.findings]
+    assert any("A(s)" in p and "noise in the model's inputs" in p for p in result.problems), \
+        result.problems
+
+
 def test_a_brake_fade_is_named_with_no_violated_relation_beside_it(reference, tmp_path):
     """The gain relations are judged against the model's whole gain law, its fade included:
     a fade the model has explained is no violated 'brake gain constant in speed'."""

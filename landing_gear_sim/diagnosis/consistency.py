@@ -58,6 +58,8 @@ from landing_gear_sim.diagnosis.relations import (
     Z_VIOLATED,
     Check,
     Relation,
+    structural,
+    violations,
 )
 from landing_gear_sim.diagnosis.scoring import effective_count
 from landing_gear_sim.diagnosis.settled_valve import (
@@ -135,15 +137,21 @@ def coarse_channels(runs: Sequence[ClassifiedRun], checks: Sequence[Check]) -> l
 
 
 def under_floor(checks: Sequence[Check]) -> list[str]:
-    """The deviations beyond Z_VIOLATED σ that lie under their floor (for ``problems``): the
-    data show them, the diagnosis does not call them violated, and ``none`` does not rule
-    out an effect of their size (a tyre's μ_B·v² law logged at 200 Hz read 0.027 at 11σ
-    under the 0.046 its slip noise allows, and was said nowhere)."""
-    return [f"{c.describe()} lies under its floor {c.floor:.4g} {c.unit} (the least that "
-            "matters, or what the log's noise makes of it): an effect of this size is not told "
-            "from that here"
-            for c in sorted(checks, key=lambda c: -c.z)
-            if c.z > Z_VIOLATED and not c.violated]
+    """The deviations beyond Z_VIOLATED σ that lie under their floor, or within what the
+    noise in the model's inputs can make (for ``problems``): the data show them, the
+    diagnosis does not report them as structure, and ``none`` does not rule out an effect
+    of their size (a tyre's μ_B·v² law logged at 200 Hz read 0.027 at 11σ under the 0.046
+    its slip noise then allowed, and was said nowhere)."""
+    under = [f"{c.describe()} lies under its floor {c.floor:.4g} {c.unit} (the least that "
+             "matters, or what the log's noise makes of it): an effect of this size is not "
+             "told from that here"
+             for c in sorted(checks, key=lambda c: -c.z)
+             if c.z > Z_VIOLATED and not c.violated]
+    within = [f"{c.describe()} lies within the {c.noise:.4g} {c.unit} the noise in the "
+              "model's inputs can make of it (a noisy logged current fed to the valve): an "
+              "effect of this size is not told from that here"
+              for c in violations(checks) if c not in structural(checks)]
+    return under + within
 
 
 def inconsistent(broken: Sequence[Check]) -> Finding:

@@ -45,7 +45,7 @@ from landing_gear_sim.diagnosis.equations import locate_all
 from landing_gear_sim.diagnosis.findings import Finding, Signature
 from landing_gear_sim.diagnosis.identifiability import actuator_calibrated, untestable
 from landing_gear_sim.diagnosis.local import LocalGain, local_gains
-from landing_gear_sim.diagnosis.relations import Check, violations
+from landing_gear_sim.diagnosis.relations import Check, structural
 from landing_gear_sim.diagnosis.rig_bounds import scaled_to_rig
 from landing_gear_sim.diagnosis.scoring import (
     BIC_THRESHOLD,
@@ -211,8 +211,8 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
             places = locate_all(after, runs, model, simulated_after,
                                 lambda run, sim: window_regressors(run, sim, model))
             findings.append(unexplained(after, baseline_fits(runs, simulated_after), places))
-        if violations(checks):
-            findings.append(inconsistent(violations(checks)))
+        if structural(checks):
+            findings.append(inconsistent(structural(checks)))
         verdict = findings[0].cause if findings else "none"
     else:
         # not 'none' (a catalogued effect may hide in what could not be tested), and no

@@ -29,6 +29,7 @@ from landing_gear_sim.diagnosis.selection import (
     Term,
     fit_terms,
     floor_of,
+    input_noise_of,
     significant,
     term_columns,
 )
@@ -99,7 +100,7 @@ class Library(abc.ABC, Generic[S]):
         named = ", ".join(s.term.name for s in fitted.selected)
         return Check(self.relation, "campaign", f"{self.phase}, {named}", fitted.effect,
                      fitted.effect / max(fitted.z, 1e-12), floor_of(rows, self.min_effect),
-                     self.error_unit or self.unit)
+                     self.error_unit or self.unit, input_noise_of(rows))
 
     def _fit(self, campaign: Campaign, params: RigParameters
              ) -> tuple[list[Rows], Fitted | None]:

@@ -46,7 +46,9 @@ class Relation(str, enum.Enum):
 @dataclass(frozen=True)
 class Check:
     """One relation on one run (or the campaign) and phase: the deviation found, its 1-σ
-    and the floor below which it does not matter, in ``unit``."""
+    and the floor below which it does not matter, in ``unit``; and what the noise in the
+    model's inputs can make of it (a violation within that calls for a term, which the
+    scoring may accept, but is no structure to report unexplained)."""
 
     relation: Relation
     run: str
@@ -55,6 +57,7 @@ class Check:
     std: float
     floor: float
     unit: str
+    noise: float = 0.0
 
     @property
     def z(self) -> float:
@@ -72,6 +75,11 @@ class Check:
         return {"relation": self.relation, "run": self.run, "phase": self.phase,
                 "deviation": self.deviation, "std": self.std, "floor": self.floor,
                 "unit": self.unit, "violated": self.violated}
+
+
+def structural(checks: Sequence[Check]) -> list[Check]:
+    """The violated checks beyond what the noise in the model's inputs can make."""
+    return [c for c in violations(checks) if abs(c.deviation) > c.noise]
 
 
 def violations(checks: Sequence[Check]) -> list[Check]:

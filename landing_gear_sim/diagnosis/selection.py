@@ -98,6 +98,9 @@ class Rows:
     owned: np.ndarray
     scale: float
     noise: float = 0.0  # what the regressors' own noise alone makes of the error (rms)
+    # what the noise in the inputs the model is fed makes of the error (rms): a null's
+    # deviation as large as a real effect's, which only the scoring tells apart
+    input_noise: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -223,6 +226,12 @@ def floor_of(rows: Sequence[Rows], min_effect: float = MIN_EFFECT) -> float:
     errors in the variables)."""
     noise = float(np.sqrt(np.mean([r.noise ** 2 for r in rows])))
     return max(min_effect * scale_of(rows), NOISE_FLOOR * noise)
+
+
+def input_noise_of(rows: Sequence[Rows]) -> float:
+    """NOISE_FLOOR times what the inputs' noise makes of the error, over ``rows``: a
+    deviation within it is no structure of its own (:attr:`Check.noise`)."""
+    return NOISE_FLOOR * float(np.sqrt(np.mean([r.input_noise ** 2 for r in rows])))
 
 
 def scale_of(rows: Sequence[Rows]) -> float:

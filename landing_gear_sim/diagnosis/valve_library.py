@@ -16,7 +16,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.calibration.runs import ClassifiedRun, RunKind
 from landing_gear_sim.calibration.slots import Slot, map_signals, seen
 from landing_gear_sim.diagnosis.catalogue import ACTUATOR, STATIC_MAP
 from landing_gear_sim.diagnosis.equations import Equation
@@ -39,7 +39,13 @@ from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.actuator import actuator_matrices, settled_states
 from landing_gear_sim.model.parameters import INDEX, RigParameters
-from landing_gear_sim.model.scenario import logged_to_held
+from landing_gear_sim.model.scenario import (
+    MEDIAN_GAIN,
+    NOISY_CURRENT_A,
+    current_noise_a,
+    logged_to_held,
+    median_samples,
+)
 from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.units import display
 
@@ -124,7 +130,9 @@ class ValveRun:
     """An actuator run under a model: the current the valve was fed [A], A(s)'s states as
     the model steps them ((n, 3): P [Pa], Ṗ [Pa/s], the delayed static pressure [Pa]), the
     measured pressure less the model's through its channel [Pa], the model's sensitivity to
-    each parameter the calibration owns in A(s) ((n, j) [Pa per unit]), its rate [Hz]."""
+    each parameter the calibration owns in A(s) ((n, j) [Pa per unit]), its rate [Hz], and
+    what the logger's noise left in the current it was fed makes of the model's pressure
+    ((n,) [Pa], one draw; zeros: none given)."""
 
     current_a: np.ndarray
     states: np.ndarray
@@ -132,22 +140,43 @@ class ValveRun:
     owned: np.ndarray
     matrices: np.ndarray
     rate_hz: float
+    noise_pa: np.ndarray
 
 
 OWNED = (*ACTUATOR, K.ACTUATOR_GAIN, *STATIC_MAP[:3], K.ACTUATOR_DELAY_S)
 
 
-def valve_run(run: ClassifiedRun, params: RigParameters) -> ValveRun:
-    """``run`` under ``params`` (see :class:`ValveRun`)."""
+def valve_run(run: ClassifiedRun, params: RigParameters, noise_a: float = 0.0) -> ValveRun:
+    """``run`` under ``params`` (see :class:`ValveRun`), its logger's current noise
+    ``noise_a`` [A] (:func:`command_noise_a`)."""
     current = logged_to_held(run.command_a)
     vector = params.vector()
     matrices = actuator_matrices(vector, 1.0 / run.rate_hz)
     states = settled_states(vector, matrices, current)
     channel = SensorModel.of(params).pressure_channel
     residual = run.pressure_pa - channel(run.time_s, states[:, 0])
+    fed = _fed_noise_a(run, noise_a)
+    noise = np.zeros(current.size) if fed == 0.0 else settled_states(
+        vector, matrices, current + fed * np.random.default_rng(0).standard_normal(
+            current.size))[:, 0] - states[:, 0]
     return ValveRun(current, states, residual,
                     _sensitivities(params, current, run.rate_hz, states[:, 0]),
-                    matrices, run.rate_hz)
+                    matrices, run.rate_hz, noise)
+
+
+def command_noise_a(runs: Sequence[ClassifiedRun]) -> float:
+    """The logger's white noise on the current [A]: the least of the actuator runs' (one
+    logger wrote them all; a clean 200 Hz sweep's own steps read as 3.5 mA of it, a
+    ramp's read nothing)."""
+    return min((current_noise_a(r.current_a) for r in runs if not r.braking), default=0.0)
+
+
+def _fed_noise_a(run: ClassifiedRun, noise_a: float) -> float:
+    """The noise ``noise_a`` as the model is fed it: through the command's running median
+    where the run's command is denoised (:attr:`ClassifiedRun.command_a`)."""
+    if run.kind is RunKind.ACTUATOR_DYNAMIC or noise_a <= NOISY_CURRENT_A:
+        return noise_a
+    return noise_a * MEDIAN_GAIN / np.sqrt(median_samples(run.rate_hz))
 
 
 def _owned(params: RigParameters) -> tuple[str, ...]:
@@ -288,7 +317,8 @@ class ValveDynamicsLibrary(Library[ValveRun]):
     def sources(self, campaign: Campaign, params: RigParameters) -> list[ValveRun]:
         if not params.has("actuator_dynamics"):
             return []
-        return [valve_run(r, params) for r in campaign.runs if not r.braking]
+        noise = command_noise_a(campaign.runs)
+        return [valve_run(r, params, noise) for r in campaign.runs if not r.braking]
 
     def rows(self, source: ValveRun, params: RigParameters,
              terms: Sequence[Term[ValveRun]] | None = None) -> Rows | None:
@@ -304,8 +334,11 @@ class ValveDynamicsLibrary(Library[ValveRun]):
         columns = [_secant(source, params, t.code, place)
                    if t.code is not None else variable(t, source, params)
                    for t in terms or self.terms]
+        # a noisy current fed to the model is errors in the variables: its √ΔP and sgn Ṗ
+        # read a null's 200 Hz log (6.7 mA) at 12.6 kPa and 7σ
         return Rows(source.residual_pa[index], np.column_stack(columns)[index],
-                    source.owned[index], scale)
+                    source.owned[index], scale,
+                    input_noise=float(np.sqrt(np.mean(source.noise_pa[index] ** 2))))
 
     def law(self, written: str, params: RigParameters) -> str:
         wn = display(params.number(K.ACTUATOR_NATURAL_FREQUENCY_HZ), "Hz", ".3g")

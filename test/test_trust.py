@@ -101,6 +101,9 @@ def test_a_null_logged_at_200_hz_through_a_noisy_adc_is_none_and_says_what_it_ca
     assert result.verdict == "none", [f.evidence for f in result.findings]
     assert any("A(s)" in p and "noise in the model's inputs" in p for p in result.problems), \
         result.problems
+    within = [c.to_json() for c in result.consistency
+              if c.relation == Relation.VALVE_DYNAMICS and c.violated]
+    assert within and all(c["input_noise"] > abs(c["deviation"]) for c in within), within
 
 
 def test_a_brake_fade_is_named_with_no_violated_relation_beside_it(reference, tmp_path):

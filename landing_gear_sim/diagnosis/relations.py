@@ -74,7 +74,7 @@ class Check:
     def to_json(self) -> dict[str, object]:
         return {"relation": self.relation, "run": self.run, "phase": self.phase,
                 "deviation": self.deviation, "std": self.std, "floor": self.floor,
-                "unit": self.unit, "violated": self.violated}
+                "unit": self.unit, "violated": self.violated, "input_noise": self.noise}
 
 
 def structural(checks: Sequence[Check]) -> list[Check]:

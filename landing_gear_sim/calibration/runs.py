@@ -24,7 +24,12 @@ import numpy as np
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s
-from landing_gear_sim.model.scenario import brake_start_index, current_noise_a, denoised_command
+from landing_gear_sim.model.scenario import (
+    brake_start_index,
+    current_noise_a,
+    denoised_command,
+    leftover_noise_a,
+)
 from msg_tools.errors import RunFormatError
 from msg_tools.io import is_uniform, resample
 from msg_tools.run import Run
@@ -149,6 +154,12 @@ class ClassifiedRun(Run):
         if self.kind is RunKind.ACTUATOR_DYNAMIC:
             return self.current_a
         return denoised_command(self.current_a, self.rate_hz)[0]
+
+    def fed_noise_a(self, noise_a: float) -> float:
+        """The σ [A] of a logger's white noise ``noise_a`` left in :attr:`command_a`."""
+        if self.kind is RunKind.ACTUATOR_DYNAMIC:
+            return noise_a
+        return leftover_noise_a(noise_a, self.rate_hz)
 
 
 def on_uniform_grid(run: Run) -> Run:

@@ -58,7 +58,6 @@ from landing_gear_sim.diagnosis.relations import (
     Z_VIOLATED,
     Check,
     Relation,
-    structural,
     violations,
 )
 from landing_gear_sim.diagnosis.scoring import effective_count
@@ -147,10 +146,10 @@ def under_floor(checks: Sequence[Check]) -> list[str]:
              "told from that here"
              for c in sorted(checks, key=lambda c: -c.z)
              if c.z > Z_VIOLATED and not c.violated]
-    within = [f"{c.describe()} lies within the {c.noise:.4g} {c.unit} the noise in the "
-              "model's inputs can make of it (a noisy logged current fed to the valve): an "
-              "effect of this size is not told from that here"
-              for c in violations(checks) if c not in structural(checks)]
+    within = [f"{c.describe()} lies within the {c.input_noise:.4g} {c.unit} the noise in "
+              "the model's inputs can make of it (a noisy logged current fed to the valve): "
+              "an effect of this size is not told from that here"
+              for c in violations(checks) if abs(c.deviation) <= c.input_noise]
     return under + within
 
 

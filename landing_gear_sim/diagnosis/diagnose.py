@@ -211,8 +211,8 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
             places = locate_all(after, runs, model, simulated_after,
                                 lambda run, sim: window_regressors(run, sim, model))
             findings.append(unexplained(after, baseline_fits(runs, simulated_after), places))
-        if structural(checks):
-            findings.append(inconsistent(structural(checks)))
+        if broken := structural(checks):
+            findings.append(inconsistent(broken))
         verdict = findings[0].cause if findings else "none"
     else:
         # not 'none' (a catalogued effect may hide in what could not be tested), and no

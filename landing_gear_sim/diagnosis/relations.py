@@ -57,7 +57,7 @@ class Check:
     std: float
     floor: float
     unit: str
-    noise: float = 0.0
+    input_noise: float = 0.0
 
     @property
     def z(self) -> float:
@@ -74,12 +74,13 @@ class Check:
     def to_json(self) -> dict[str, object]:
         return {"relation": self.relation, "run": self.run, "phase": self.phase,
                 "deviation": self.deviation, "std": self.std, "floor": self.floor,
-                "unit": self.unit, "violated": self.violated, "input_noise": self.noise}
+                "unit": self.unit, "violated": self.violated,
+                "input_noise": self.input_noise}
 
 
 def structural(checks: Sequence[Check]) -> list[Check]:
     """The violated checks beyond what the noise in the model's inputs can make."""
-    return [c for c in violations(checks) if abs(c.deviation) > c.noise]
+    return [c for c in violations(checks) if abs(c.deviation) > c.input_noise]
 
 
 def violations(checks: Sequence[Check]) -> list[Check]:

@@ -230,7 +230,7 @@ def floor_of(rows: Sequence[Rows], min_effect: float = MIN_EFFECT) -> float:
 
 def input_noise_of(rows: Sequence[Rows]) -> float:
     """NOISE_FLOOR times what the inputs' noise makes of the error, over ``rows``: a
-    deviation within it is no structure of its own (:attr:`Check.noise`)."""
+    deviation within it is no structure of its own (:attr:`Check.input_noise`)."""
     return NOISE_FLOOR * float(np.sqrt(np.mean([r.input_noise ** 2 for r in rows])))
 
 

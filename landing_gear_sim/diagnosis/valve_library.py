@@ -16,7 +16,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from landing_gear_sim.calibration.runs import ClassifiedRun, RunKind
+from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.slots import Slot, map_signals, seen
 from landing_gear_sim.diagnosis.catalogue import ACTUATOR, STATIC_MAP
 from landing_gear_sim.diagnosis.equations import Equation
@@ -39,13 +39,7 @@ from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.actuator import actuator_matrices, settled_states
 from landing_gear_sim.model.parameters import INDEX, RigParameters
-from landing_gear_sim.model.scenario import (
-    MEDIAN_GAIN,
-    NOISY_CURRENT_A,
-    current_noise_a,
-    logged_to_held,
-    median_samples,
-)
+from landing_gear_sim.model.scenario import current_noise_a, logged_to_held
 from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.units import display
 
@@ -155,7 +149,7 @@ def valve_run(run: ClassifiedRun, params: RigParameters, noise_a: float = 0.0) -
     states = settled_states(vector, matrices, current)
     channel = SensorModel.of(params).pressure_channel
     residual = run.pressure_pa - channel(run.time_s, states[:, 0])
-    fed = _fed_noise_a(run, noise_a)
+    fed = run.fed_noise_a(noise_a)
     noise = np.zeros(current.size) if fed == 0.0 else settled_states(
         vector, matrices, current + fed * np.random.default_rng(0).standard_normal(
             current.size))[:, 0] - states[:, 0]
@@ -170,13 +164,6 @@ def command_noise_a(runs: Sequence[ClassifiedRun]) -> float:
     ramp's read nothing)."""
     return min((current_noise_a(r.current_a) for r in runs if not r.braking), default=0.0)
 
-
-def _fed_noise_a(run: ClassifiedRun, noise_a: float) -> float:
-    """The noise ``noise_a`` as the model is fed it: through the command's running median
-    where the run's command is denoised (:attr:`ClassifiedRun.command_a`)."""
-    if run.kind is RunKind.ACTUATOR_DYNAMIC or noise_a <= NOISY_CURRENT_A:
-        return noise_a
-    return noise_a * MEDIAN_GAIN / np.sqrt(median_samples(run.rate_hz))
 
 
 def _owned(params: RigParameters) -> tuple[str, ...]:

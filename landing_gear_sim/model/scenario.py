@@ -196,11 +196,20 @@ def denoised_command(current_a: np.ndarray, rate_hz: float = DEFAULT_RATE_HZ
     noise = current_noise_a(current)
     if noise <= NOISY_CURRENT_A:
         return current, noise
-    samples = median_samples(rate_hz)
     import scipy.ndimage  # here, as scipy.signal above
 
-    command = scipy.ndimage.median_filter(current, size=samples, mode="nearest")
-    return command, noise * MEDIAN_GAIN / np.sqrt(samples)
+    command = scipy.ndimage.median_filter(current, size=median_samples(rate_hz),
+                                          mode="nearest")
+    return command, leftover_noise_a(noise, rate_hz)
+
+
+def leftover_noise_a(noise_a: float, rate_hz: float = DEFAULT_RATE_HZ) -> float:
+    """The σ [A] of a log's white noise ``noise_a`` left in the command
+    :func:`denoised_command` makes of it: all of it in a clean log, the running median's
+    share in a noisy one."""
+    if noise_a <= NOISY_CURRENT_A:
+        return noise_a
+    return noise_a * MEDIAN_GAIN / np.sqrt(median_samples(rate_hz))
 
 
 def brake_start_index(current_a: np.ndarray, rate_hz: float = DEFAULT_RATE_HZ) -> int | None:

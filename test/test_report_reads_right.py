@@ -3,6 +3,8 @@ reason for every candidate's yes or no."""
 
 from __future__ import annotations
 
+import html
+
 from landing_gear_sim.diagnosis.relations import Check, Relation
 from landing_gear_sim.report.diagnosis import paired_checks
 
@@ -172,3 +174,24 @@ def test_the_local_gain_figure_keeps_its_keys_off_the_estimates(tmp_path, monkey
     bands = [line for axis in fig.axes[:len(VARIABLES)] for line in axis.get_lines()
              if len(line.get_xdata()) == 5]
     assert bands and all(line.get_linestyle() == "None" for line in bands)
+
+
+def test_a_violation_within_the_inputs_noise_reads_apart_from_structure(tmp_path):
+    """A null's A(s) check violated within what the current's noise makes of it stood in the
+    page as a red 'VIOLATED' beside the verdict none: the JSON carried the input noise, the
+    page did not. It now says so in the table, the chart and the text, and only a violation
+    beyond it is structure."""
+    from landing_gear_sim.diagnosis.relations import structural
+    from landing_gear_sim.report.diagnosis import _check_cell, _colour, _consistency_section
+
+    within = Check(Relation.VALVE_DYNAMICS, "actuator_ramp", "√ΔP", 12.6e3, 1.8e3, 5e3, "Pa",
+                   input_noise=15e3)
+    beyond = Check(Relation.VALVE_DYNAMICS, "actuator_ramp", "sgn Ṗ", 40e3, 1.8e3, 5e3, "Pa",
+                   input_noise=15e3)
+    assert within.violated and within.within_input_noise and not beyond.within_input_noise
+    assert structural([within, beyond]) == [beyond]
+    assert "VIOLATED" not in _check_cell(within) and "inputs' noise" in _check_cell(within)
+    assert "VIOLATED" in _check_cell(beyond)
+    assert _colour(within) != _colour(beyond) == "tab:red"
+    _, body = _consistency_section([within, beyond], [within, beyond], tmp_path)
+    assert "inputs' noise" in html.unescape(body) and "1.5e+04 Pa" in body

@@ -141,15 +141,15 @@ def under_floor(checks: Sequence[Check]) -> list[str]:
     diagnosis does not report them as structure, and ``none`` does not rule out an effect
     of their size (a tyre's μ_B·v² law logged at 200 Hz read 0.027 at 11σ under the 0.046
     its slip noise then allowed, and was said nowhere)."""
-    under = [f"{c.describe()} lies under its floor {c.floor:.4g} {c.unit} (the least that "
+    under = [f"{c.reading()} lies under its floor {c.floor:.4g} {c.unit} (the least that "
              "matters, or what the log's noise makes of it): an effect of this size is not "
              "told from that here"
              for c in sorted(checks, key=lambda c: -c.z)
              if c.z > Z_VIOLATED and not c.violated]
-    within = [f"{c.describe()} lies within the {c.input_noise:.4g} {c.unit} the noise in "
+    within = [f"{c.reading()} lies within the {c.input_noise:.4g} {c.unit} the noise in "
               "the model's inputs can make of it (a noisy logged current fed to the valve): "
               "an effect of this size is not told from that here"
-              for c in violations(checks) if abs(c.deviation) <= c.input_noise]
+              for c in violations(checks) if c.within_input_noise]
     return under + within
 
 

@@ -67,9 +67,26 @@ class Check:
     def violated(self) -> bool:
         return self.z > Z_VIOLATED and abs(self.deviation) > self.floor
 
+    @property
+    def within_input_noise(self) -> bool:
+        """Violated, but no further out than the noise in the model's inputs can move it."""
+        return self.violated and abs(self.deviation) <= self.input_noise
+
     def describe(self) -> str:
+        return self.reading() + self.mark()
+
+    def reading(self) -> str:
+        """The relation, where it was checked and what it read, without a judgement."""
         return (f"{self.relation} ({self.run}, {self.phase}): {self.deviation:+.4g} {self.unit} "
-                f"± {self.std:.2g} ({self.z:.0f}σ)" + ("  VIOLATED" if self.violated else ""))
+                f"± {self.std:.2g} ({self.z:.0f}σ)")
+
+    def mark(self) -> str:
+        """How the check reads beside a verdict: violated, violated within the noise the
+        model's inputs carry (no structure), or nothing."""
+        if self.within_input_noise:
+            return (f"  violated within the inputs' noise ({self.input_noise:.2g} {self.unit}):"
+                    " no structure")
+        return "  VIOLATED" if self.violated else ""
 
     def to_json(self) -> dict[str, object]:
         return {"relation": self.relation, "run": self.run, "phase": self.phase,
@@ -80,7 +97,7 @@ class Check:
 
 def structural(checks: Sequence[Check]) -> list[Check]:
     """The violated checks beyond what the noise in the model's inputs can make."""
-    return [c for c in violations(checks) if abs(c.deviation) > c.input_noise]
+    return [c for c in violations(checks) if not c.within_input_noise]
 
 
 def violations(checks: Sequence[Check]) -> list[Check]:

@@ -171,16 +171,21 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
 def _consistency_section(calibrated: Sequence[Check], extended: Sequence[Check],
                          folder: Path) -> tuple[str, str]:
     pairs = paired_checks(calibrated, extended)
-    table = html_table(["relation", "run", "calibrated model", "extended model", "floor"],
+    table = html_table(["relation", "run", "calibrated model", "extended model", "floor",
+                        "inputs' noise"],
                        [[after.relation, after.run, _check_cell(before), _check_cell(after),
-                         f"{after.floor:.2g} {after.unit}"] for before, after in pairs])
+                         f"{after.floor:.2g} {after.unit}", _input_noise_cell(after)]
+                        for before, after in pairs])
     shown = worst_per_relation(pairs)
     caption = (f"<p>A relation is violated when its deviation is beyond {Z_VIOLATED:g} σ "
                "<i>and</i> beyond its physical floor (the size below which it does not matter "
                "to the rig, last column): the chart draws each deviation over the larger of "
                "the two, so a bar past 1 (red) is a violation and no other is. The chart "
                f"shows each of the {len(shown)} relations checked once, on its "
-               f"worst run; the table all {len(pairs)} checks.</p>")
+               f"worst run; the table all {len(pairs)} checks. A violation no further out "
+               "than the noise in the model's inputs can move it (a noisy logged current fed "
+               "to the valve: last column) is orange: it calls for terms, which the scoring "
+               "judges, but is no structure the verdict reports.</p>")
     figure = plot_consistency(shown, folder / "consistency.png") if shown else None
     image = html_image(figure, folder) if figure else ""
     return ("Consistency of what the rig measures twice", caption + image + table)
@@ -212,8 +217,13 @@ def paired_checks(calibrated: Sequence[Check], extended: Sequence[Check]
 def _check_cell(check: Check | None) -> str:
     if check is None:
         return "-"
-    return (f"{check.deviation:+.4g} ± {check.std:.2g} {check.unit} ({check.phase})"
-            + (" VIOLATED" if check.violated else ""))
+    return f"{check.deviation:+.4g} ± {check.std:.2g} {check.unit} ({check.phase})" + (
+        " violated within the inputs' noise" if check.within_input_noise
+        else " VIOLATED" if check.violated else "")
+
+
+def _input_noise_cell(check: Check) -> str:
+    return f"{check.input_noise:.2g} {check.unit}" if check.input_noise > 0 else "-"
 
 
 Pair = tuple[Check | None, Check]
@@ -247,6 +257,9 @@ def plot_consistency(rows: Sequence[tuple[Pair, int]], path: Path) -> Path:
         matplotlib.patches.Patch(color="tab:grey", alpha=a, label=label)
         for a, label in ((0.4, "calibrated model"), (1.0, "extended model"))]
     keys.append(matplotlib.patches.Patch(color="tab:red", label="violated"))
+    if any(c is not None and c.within_input_noise for pair in pairs for c in pair):
+        keys.append(matplotlib.patches.Patch(color="tab:orange",
+                                             label="violated within\nthe inputs' noise"))
     keys.append(matplotlib.lines.Line2D([], [], color="k", linestyle="--",
                                         label=f"threshold: {Z_VIOLATED:g} σ or\nthe floor"))
     ax.set_xscale("log")
@@ -275,7 +288,9 @@ def reach(check: Check | None) -> float:
 
 
 def _colour(check: Check | None) -> str:
-    return "tab:red" if check is not None and check.violated else "tab:grey"
+    if check is None or not check.violated:
+        return "tab:grey"
+    return "tab:orange" if check.within_input_noise else "tab:red"
 
 
 def _datasheet(params: RigParameters) -> str:
@@ -326,9 +341,11 @@ def diagnosis_summary(result: Diagnosis) -> str:
         lines.append(f"    evidence: {f.evidence}")
     before = [c for c in result.consistency_calibrated if c.violated]
     broken = [c for c in result.consistency if c.violated]
+    noise = sum(c.within_input_noise for c in broken)
     lines.append(f"consistency: {len(result.consistency)} relations checked, "
                  f"{len(before)} violated under the calibrated model, {len(broken)} under the "
-                 "extended one" + (":" if broken else ""))
+                 "extended one" + (f" ({noise} within the noise in the model's inputs)"
+                                   if noise else "") + (":" if broken else ""))
     lines.extend(f"  {c.describe()}" for c in broken)
     lines.extend(f"  note: {problem}" for problem in result.problems)
     return "\n".join(lines)

@@ -106,6 +106,41 @@ def test_a_null_logged_at_200_hz_through_a_noisy_adc_is_none_and_says_what_it_ca
     assert within and all(c["input_noise"] > abs(c["deviation"]) for c in within), within
 
 
+def _relaxing(rng):
+    return {"elements.tire_relaxation": True, "tyre.relaxation_length_m": rng.uniform(0.2, 0.8)}
+
+
+FRICTION = ("friction.theta1", "friction.theta2", "friction.theta3")
+
+
+def test_a_model_told_the_tyre_relaxes_calibrates_the_rigs_friction_curve(reference, tmp_path):
+    """Issue 41: a rig whose tyre relaxes over 0.69 m was calibrated to ϑ = 2.34, 14.5, 2.32
+    (its own 0.97, 27.6, 0.15) with the relaxation in the model or not: the filtered wheel
+    speed, lagging a wheel spinning up near the stop, read slips down to −0.13, where the
+    curve is −32; the model with the true relaxation then lost to three tyre terms."""
+    runs, rig = _campaign(reference, tmp_path, 3174, _relaxing, names=None)
+    told = reference.replace({"elements.tire_relaxation": True,
+                              "tyre.relaxation_length_m": 0.69}, "the relaxation found")
+    calibrated = identify(runs, told, jackknife=False).params
+    for key, tolerance in zip(FRICTION, (0.05, 0.05, 0.5), strict=True):
+        assert calibrated.number(key) == pytest.approx(rig.number(key), rel=tolerance), key
+
+
+def test_a_relaxing_tyre_logged_at_200_hz_is_named_not_replaced_by_tyre_terms(reference,
+                                                                             tmp_path):
+    """Issue 41: the sweep's relaxation 3174, logged at 200 Hz, came out `discovered tyre`
+    (μ_B·√λ, μ_B³, μ_B·v), the relaxation found at 0.686 m for a drawn 0.686 m and then
+    replaced: the re-calibrated model it was in had a friction curve bent by a lagging
+    wheel reading (see the test above)."""
+    runs, rig = _campaign(reference, tmp_path, 3174, _relaxing, logger=Logger(rate_hz=200.0),
+                          names=None)
+    result = _consistent(diagnose(runs, reference))
+    assert result.verdict == "tire_relaxation", [f.evidence for f in result.findings]
+    (found,) = [f for f in result.findings if f.cause == "tire_relaxation"]
+    assert found.parameters["relaxation_length_m"] == pytest.approx(
+        rig.number("tyre.relaxation_length_m"), rel=0.2)
+
+
 def test_a_brake_fade_is_named_with_no_violated_relation_beside_it(reference, tmp_path):
     """The gain relations are judged against the model's whole gain law, its fade included:
     a fade the model has explained is no violated 'brake gain constant in speed'."""

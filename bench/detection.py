@@ -2,8 +2,8 @@
 and the campaigns of an independent simulator.
 
 Run: ``python bench/detection.py [--per-cause N] [--nulls N] [--causes a,b] [--seed S]
-[--logger-realities] [--independent DIR] [--campaigns CAUSE:SEED,...] [--scheduler
-tcp://HOST:8786] [--workers N]`` (not
+[--logger-realities] [--independent DIR] [--campaigns CAUSE:SEED,...] [--keep DIR]
+[--scheduler tcp://HOST:8786] [--workers N]`` (not
 part of ``make bench``: ~20-40 s per campaign here, so the default sweep of 3 campaigns per
 cause and family, 5 null campaigns and the ten independent ones takes about 20 minutes on 2
 cores). The campaigns run on Dask, like ``history``: a local cluster
@@ -30,7 +30,8 @@ drawn here through the plant's generic slots; right when discovered in the equat
 held-out gain (no value: no term of the library is the law). ``--causes`` names them like
 the others. ``--campaigns`` runs given (cause, seed) pairs alone: a seed draws the rig, the
 effect and (with ``--logger-realities``) the logger, so a failure seen in a sweep, or the
-seeds whose logger is 200 Hz, can be run again by themselves.
+seeds whose logger is 200 Hz, can be run again by themselves; ``--keep DIR`` keeps each of
+them in DIR/CAUSE-SEED with its ``generating-parameters.yaml``, to diagnose by hand.
 
 Data the project did not make: the campaigns under ``../shared/data/independent/`` (or
 ``--independent DIR``; skipped when absent), judged against their ``truth.json``
@@ -41,11 +42,12 @@ the key-parameter errors.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import sys
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -223,23 +225,23 @@ REALITY = 0.3
 
 
 def run_case(cause: str | None, seed: int, datasheet: RigParameters, light: bool = False,
-             realities: bool = False) -> tuple[bool, str, float]:
+             realities: bool = False, keep: str | None = None) -> tuple[bool, str, float]:
     """Diagnose one generated campaign (with the light stops when ``light`` or when the
-    cause needs them; with ``realities`` as a random logger writes it); (correct, verdict,
-    key-parameter error)."""
+    cause needs them; with ``realities`` as a random logger writes it; kept under ``keep``
+    with the parameters that made it, else thrown away); (correct, verdict, key-parameter
+    error)."""
     rng = np.random.default_rng(seed)
     rig = rig_like(datasheet, rng)
     if cause in OUTSIDE:
-        return _outside(cause, rig, rng, seed, datasheet, realities)
+        return _outside(cause, rig, rng, seed, datasheet, realities, keep)
     case = (CASES | FAMILIES).get(cause) if cause else None
     if case is not None:
         rig = rig.replace(case.draw(rng, datasheet), "hidden effect")
     logger = random_logger(np.random.default_rng([seed, 2])) if realities else None
-    with tempfile.TemporaryDirectory() as folder:
-        generate_campaign(Path(folder), rig, seed, light=light or (case is not None
-                                                                   and case.light),
+    with _campaign_folder(keep, cause, seed) as folder:
+        generate_campaign(folder, rig, seed, light=light or (case is not None and case.light),
                           logger=logger)
-        runs = read_campaign(Path(folder)).runs
+        runs = read_campaign(folder).runs
     result = diagnose(runs, datasheet, without=list(case.without) if case else [])
     if case is None:
         return result.verdict == "none", result.verdict, math.nan
@@ -257,16 +259,31 @@ def run_case(cause: str | None, seed: int, datasheet: RigParameters, light: bool
     return _within(case, found[0].parameters[_key(case, rig)], rig, result.verdict)
 
 
+@contextlib.contextmanager
+def _campaign_folder(keep: str | None, cause: str | None, seed: int) -> Iterator[Path]:
+    """Where a generated campaign is written: ``keep``/CAUSE-SEED, kept (a sweep's miss
+    diagnosed again by hand, its truth in generating-parameters.yaml), or a temporary
+    folder."""
+    if keep is not None:
+        folder = Path(keep) / f"{cause or 'none'}-{seed}"
+        folder.mkdir(parents=True, exist_ok=True)
+        yield folder
+        return
+    with tempfile.TemporaryDirectory() as temporary:
+        yield Path(temporary)
+
+
 def _outside(cause: str, rig: RigParameters, rng: np.random.Generator, seed: int,
-             datasheet: RigParameters, realities: bool) -> tuple[bool, str, float]:
+             datasheet: RigParameters, realities: bool, keep: str | None = None
+             ) -> tuple[bool, str, float]:
     """A campaign of an OUTSIDE effect: right when discovered in its equation with a
     held-out gain (no value: the law is none of the library's terms)."""
     equation, draw = OUTSIDE[cause]
     rig = rig.replace(draw(rng, datasheet), "hidden effect")
     logger = random_logger(np.random.default_rng([seed, 2])) if realities else None
-    with tempfile.TemporaryDirectory() as folder:
-        generate_campaign(Path(folder), rig, seed, logger=logger)
-        runs = read_campaign(Path(folder)).runs
+    with _campaign_folder(keep, cause, seed) as folder:
+        generate_campaign(folder, rig, seed, logger=logger)
+        runs = read_campaign(folder).runs
     result = diagnose(runs, datasheet)
     first = result.findings[0] if result.findings else None
     ok = (result.verdict == "discovered" and first is not None and first.family == equation
@@ -297,11 +314,11 @@ def _within(case: Case, value: float, rig: RigParameters, verdict: str
     return error <= case.tolerance, verdict, error
 
 
-def case_task(cause: str | None, seed: int, light: bool = False, realities: bool = False
-              ) -> dict:
+def case_task(cause: str | None, seed: int, light: bool = False, realities: bool = False,
+              keep: str | None = None) -> dict:
     """One campaign of the sweep, as a journal row."""
     started = time.perf_counter()
-    ok, verdict, error = run_case(cause, seed, load_parameters(), light, realities)
+    ok, verdict, error = run_case(cause, seed, load_parameters(), light, realities, keep)
     truth = cause or "none"
     if truth in OUTSIDE:
         truth = f"discovered {OUTSIDE[truth][0]} ({truth})"
@@ -463,6 +480,9 @@ def main() -> None:
     parser.add_argument("--campaigns", type=_pairs, default=None, metavar="CAUSE:SEED,...",
                         help="only these campaigns of the own generator (none:SEED a null; "
                              "e.g. seeds whose random logger is 200 Hz), nothing else")
+    parser.add_argument("--keep", type=Path, default=None, metavar="DIR",
+                        help="write each own campaign to DIR/CAUSE-SEED with the parameters "
+                             "that made it (generating-parameters.yaml), to diagnose again")
     args = parser.parse_args()
     plan = [(c, args.seed + 17 * i + j) for i, c in enumerate(args.causes.split(","))
             for j in range(args.per_cause)]
@@ -472,8 +492,10 @@ def main() -> None:
     if args.campaigns is not None:
         plan = args.campaigns
     suffix = ("-light" if args.light_runs else "") + ("-logger" if args.logger_realities else "")
+    keep = str(args.keep.resolve()) if args.keep else None  # a worker's cwd may differ
     own = [Task(f"{cause or 'none'}-{seed}{suffix}", case_task,
-                (cause, seed, args.light_runs, args.logger_realities)) for cause, seed in plan]
+                (cause, seed, args.light_runs, args.logger_realities, keep))
+           for cause, seed in plan]
     theirs = [Task(f"independent-{folder.name}", independent_task, (str(folder),))
               for folder in independent.campaigns(args.independent)]
     unseen = [Task(f"unseen-{folder.name}", unseen_task, (str(folder), equation))

@@ -165,7 +165,6 @@ def command_noise_a(runs: Sequence[ClassifiedRun]) -> float:
     return min((current_noise_a(r.current_a) for r in runs if not r.braking), default=0.0)
 
 
-
 def _owned(params: RigParameters) -> tuple[str, ...]:
     """The owned parameters of A(s) under ``params``: the delay only where it has one."""
     return tuple(k for k in OWNED if k != K.ACTUATOR_DELAY_S or params.has("actuator_delay"))

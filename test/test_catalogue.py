@@ -66,14 +66,14 @@ def test_the_right_candidate_explains_more_than_a_wrong_one(reference, tmp_path)
     assert right.cost < 0.5 * wrong.cost
 
 
-def test_a_fits_jacobian_is_scipys_forward_difference_on_the_unit_box():
+def test_a_fits_jacobian_is_scipys_forward_difference_within_its_bounds():
     """The fits' Jacobian simulates its columns side by side; it must be the one scipy's
     '2-point' differences gave (relative steps, backward at the box's edge), to the bit and
     in its layout: the solver's rounding follows it, and a 1-ulp step once moved a fade's
     fit to another optimum."""
     from scipy.optimize._numdiff import approx_derivative
 
-    from landing_gear_sim.diagnosis.objective import DIFF_STEP, Objective
+    from landing_gear_sim.calibration.differences import DIFF_STEP, Objective
 
     matrix = np.random.default_rng(3).normal(size=(9, 4))
     calls: list[int] = []
@@ -94,6 +94,13 @@ def test_a_fits_jacobian_is_scipys_forward_difference_on_the_unit_box():
         assert np.array_equal(ours, theirs)
         assert ours.flags.f_contiguous == theirs.flags.f_contiguous
     assert calls == [1, 4, 1, 4]  # the columns in one call; the point's residual reused
+    # another box: the friction curve's refinement, in factors of its start
+    within = Objective(residuals, 0.2, 5.0)
+    for u in (np.array([0.2, 1.0, 4.9999, 5.0]), np.array([1.3, 0.2000001, 2.0, 4.0])):
+        within.fun(u)
+        theirs = approx_derivative(values, u, method="2-point", rel_step=DIFF_STEP,
+                                   bounds=(0.2, 5.0))
+        assert np.array_equal(within.jac(u), theirs)
 
 
 def test_candidates_that_refit_the_same_base_parameters_share_one_null_fit(reference,

@@ -23,6 +23,7 @@ from landing_gear_sim.model.actuator import actuator_pressure, second_order_resp
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.scenario import logged_to_held
 from landing_gear_sim.model.sensors import SensorModel
+from landing_gear_sim.processes import map_threads
 from msg_tools.run import Run
 from msg_tools.units import PA_PER_BAR
 
@@ -238,7 +239,7 @@ def _dead_time_s(residual: Callable[[Sequence[float]], np.ndarray], wn: float,
     in (on step logs of 50–150 ms delays a start from 0 ended in the same place, worst
     1.3 %)."""
     grid = np.arange(0.0, MAX_DELAY_S, DELAY_GRID_S)
-    costs = [float(np.sum(residual([wn, zeta, delay]) ** 2)) for delay in grid]
+    costs = map_threads(lambda delay: float(np.sum(residual([wn, zeta, delay]) ** 2)), grid)
     return float(grid[int(np.argmin(costs))])
 
 

@@ -7,10 +7,11 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 
 import numpy as np
-from scipy.optimize import least_squares
+from scipy.optimize import OptimizeResult, least_squares
 
 from landing_gear_sim.calibration.braking import LOADED_N, Braking, hub_speed
-from landing_gear_sim.calibration.measured import simulate_all
+from landing_gear_sim.calibration.differences import Objective
+from landing_gear_sim.calibration.measured import simulate_run
 from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
 from landing_gear_sim.calibration.slots import Slot
 from landing_gear_sim.calibration.statistics import Estimate, covariance_std, run_weights
@@ -20,6 +21,7 @@ from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.elements import MIN_HUB_SPEED_M_S, burckhardt_mu, slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import friction_at, load_factor_at, rolling_radius_at
+from landing_gear_sim.processes import map_threads
 from msg_tools.run import Run
 
 KEYS = (K.FRICTION_THETA1, K.FRICTION_THETA2, K.FRICTION_THETA3)
@@ -149,15 +151,23 @@ def refine_friction(runs: Sequence[ClassifiedRun], p: RigParameters, jackknife: 
         flywheel = simulated.flywheel_speed_rad_s[window] - run.flywheel_speed_rad_s[window]
         return (wheel - ratio * flywheel)[::5]
 
-    def residual(theta: np.ndarray, chosen: Sequence[int]) -> np.ndarray:
-        trial = p.replace(dict(zip(keys, theta * start, strict=True)), "identify")
-        ratio = trial.number(K.FLYWHEEL_RADIUS_M) / trial.number(K.WHEEL_UNLOADED_RADIUS_M)
-        simulated = simulate_all([runs[i] for i in chosen], trial)
-        return np.concatenate([weights[i] * slip_error(runs[i], sim, windows[i], ratio)
-                               for i, sim in zip(chosen, simulated, strict=True)])
+    def residuals(thetas: Sequence[np.ndarray], chosen: Sequence[int]) -> list[np.ndarray]:
+        # every (θ, run) simulated side by side: a Jacobian's columns share the cores
+        trials = [p.replace(dict(zip(keys, theta * start, strict=True)), "identify")
+                  for theta in thetas]
 
-    fit = least_squares(lambda th: residual(th, range(len(runs))), np.ones(3), diff_step=1e-4,
-                        bounds=REFINE_BOUNDS, max_nfev=REFINE_ITERATIONS)
+        def error(pair: tuple[RigParameters, int]) -> np.ndarray:
+            trial, i = pair
+            ratio = trial.number(K.FLYWHEEL_RADIUS_M) / trial.number(K.WHEEL_UNLOADED_RADIUS_M)
+            simulated, _ = simulate_run(runs[i], trial)
+            return weights[i] * slip_error(runs[i], simulated, windows[i], ratio)
+
+        errors = map_threads(error, [(trial, i) for trial in trials for i in chosen])
+        n = len(chosen)
+        return [np.concatenate(errors[j * n:(j + 1) * n]) for j in range(len(trials))]
+
+    fit = _least_squares(lambda thetas: residuals(thetas, range(len(runs))), np.ones(3),
+                         REFINE_ITERATIONS)
     pinned = np.isclose(fit.x, REFINE_BOUNDS[0]) | np.isclose(fit.x, REFINE_BOUNDS[1])
     if np.any(pinned):
         which = ", ".join(f"ϑ{i + 1}" for i in np.flatnonzero(pinned))
@@ -168,7 +178,7 @@ def refine_friction(runs: Sequence[ClassifiedRun], p: RigParameters, jackknife: 
             "slip: add oscillating runs, or keep ϑ3 with --fix-theta3)")
     std = covariance_std(fit, 3)
     if jackknife:
-        std = np.maximum(std, _jackknife_std(residual, fit.x, len(runs)))
+        std = np.maximum(std, _jackknife_std(residuals, fit.x, len(runs)))
     names = tuple(r.name for r in runs)
     method = "output error on wheel vs flywheel speed; σ: max(residual, jackknife)" + (
         f" (stopped at its budget of {REFINE_ITERATIONS} steps)" if fit.status == 0 else "")
@@ -176,13 +186,22 @@ def refine_friction(runs: Sequence[ClassifiedRun], p: RigParameters, jackknife: 
             for k, v, sd in zip(keys, fit.x * start, std * start, strict=True)]
 
 
-def _jackknife_std(residual: Callable[[np.ndarray, Sequence[int]], np.ndarray],
+def _least_squares(residuals: Callable[[Sequence[np.ndarray]], list[np.ndarray]],
+                   start: np.ndarray, iterations: int | None = None) -> OptimizeResult:
+    """The refinement's least squares within REFINE_BOUNDS, at most ``iterations`` steps."""
+    objective = Objective(residuals, *REFINE_BOUNDS)
+    return least_squares(objective.fun, start, jac=objective.jac, bounds=REFINE_BOUNDS,
+                         max_nfev=iterations)
+
+
+def _jackknife_std(residuals: Callable[[Sequence[np.ndarray], Sequence[int]],
+                                       list[np.ndarray]],
                    solution: np.ndarray, n_runs: int) -> np.ndarray:
     """Leave-one-run-out spread of the fit: run-to-run variability the residuals hide."""
     if n_runs < 3:
         return np.zeros_like(solution)
-    fits = [least_squares(lambda th, i=i: residual(th, [j for j in range(n_runs) if j != i]),
-                          solution, diff_step=1e-4, bounds=REFINE_BOUNDS).x
+    fits = [_least_squares(lambda thetas, i=i: residuals(
+                thetas, [j for j in range(n_runs) if j != i]), solution).x
             for i in range(n_runs)]
     spread = np.asarray(fits) - np.mean(fits, axis=0)
     return np.sqrt((n_runs - 1) / n_runs * np.sum(spread ** 2, axis=0))

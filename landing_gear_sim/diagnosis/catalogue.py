@@ -18,6 +18,7 @@ import numpy as np
 from scipy.optimize import OptimizeResult, least_squares
 
 from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration.differences import Objective
 from landing_gear_sim.calibration.runs import (
     ClassifiedRun,
     Family,
@@ -27,11 +28,7 @@ from landing_gear_sim.calibration.runs import (
     select,
 )
 from landing_gear_sim.calibration.statistics import covariance_std, input_timing_std_s
-from landing_gear_sim.diagnosis.objective import (
-    Objective,
-    Scales,
-    scaled_residuals,
-)
+from landing_gear_sim.diagnosis.objective import Scales, scaled_residuals
 from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters

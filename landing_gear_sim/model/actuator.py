@@ -169,7 +169,7 @@ def valve_slot(p, pressure_pa, rate_pa_s, static_pa):
                                              0.0, 0.0, rate_pa_s, error, 0.0))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)  # a fit's trial valves run side by side on threads
 def settled_response(p, matrices, current):
     """Pressure [Pa] for a held current sequence, starting in steady state at the first
     current (A(s) is stable: the state settles on that level first)."""

@@ -1,0 +1,62 @@
+"""A least-squares objective whose forward-difference Jacobian simulates its columns side
+by side.
+
+scipy's own finite differences simulate a Jacobian's columns one after another, each with
+its runs side by side: a campaign's longest stop (3-4 times the others) held every column's
+second core idle. Here a column's runs and the other columns' runs share the cores, and the
+Jacobian is the one scipy's '2-point' differences give, to the bit: the solver's rounding
+follows it (a 1-ulp step once moved a fade's fit to another optimum).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+DIFF_STEP = 1e-4  # relative, as scipy's diff_step (the fits were tuned with it)
+
+
+class Objective:
+    """Residuals on a box (``residuals`` of many points at once, default box the unit one)
+    for ``least_squares``: ``fun`` one point, ``jac`` its forward differences (the residual
+    at the point is the one ``fun`` just gave: the optimiser asks for a Jacobian where it
+    evaluated last)."""
+
+    def __init__(self, residuals: Callable[[Sequence[np.ndarray]], list[np.ndarray]],
+                 lower: float = 0.0, upper: float = 1.0) -> None:
+        self._residuals = residuals
+        self._bounds = (lower, upper)
+        self._last: tuple[bytes, np.ndarray] | None = None
+
+    def fun(self, u: np.ndarray) -> np.ndarray:
+        (value,) = self._residuals([u])
+        self._last = (u.tobytes(), value.copy())  # the optimiser may write into what it got
+        return value
+
+    def jac(self, u: np.ndarray) -> np.ndarray:
+        f0 = self._last[1] if self._last and self._last[0] == u.tobytes() else self.fun(u)
+        steps = forward_steps(u, *self._bounds)
+        points = [u.copy() for _ in range(u.size)]
+        for j, point in enumerate(points):
+            point[j] += steps[j]
+        columns = self._residuals(points)
+        # built by rows and transposed, as scipy's is: the solver's rounding follows the
+        # layout, and the fits were tuned on scipy's path
+        return np.array([(column - f0) / (point[j] - u[j])
+                         for j, (column, point) in enumerate(zip(columns, points,
+                                                                  strict=True))]).T
+
+
+def forward_steps(u: np.ndarray, lower: float = 0.0, upper: float = 1.0) -> np.ndarray:
+    """The steps of scipy's '2-point' differences with ``diff_step=DIFF_STEP`` at ``u``
+    (>= 0) in the box [lower, upper]: relative, a tiny absolute one where that vanishes,
+    and backward where forward would leave the box (as ``scipy.optimize._numdiff`` takes
+    them)."""
+    steps = DIFF_STEP * np.abs(u)
+    steps = np.where((u + steps) - u == 0, np.sqrt(np.finfo(float).eps) * np.maximum(1.0, u),
+                     steps)
+    below, above = u - lower, upper - u
+    fitting = steps <= np.maximum(below, above)
+    steps = np.where((u + steps > upper) & fitting, -steps, steps)
+    return np.where(fitting, steps, np.where(above >= below, above, -below))

@@ -200,8 +200,10 @@ def _jackknife_std(residuals: Callable[[Sequence[np.ndarray], Sequence[int]],
     """Leave-one-run-out spread of the fit: run-to-run variability the residuals hide."""
     if n_runs < 3:
         return np.zeros_like(solution)
-    fits = [_least_squares(lambda thetas, i=i: residuals(
-                thetas, [j for j in range(n_runs) if j != i]), solution).x
-            for i in range(n_runs)]
+    def leaving_out(i: int) -> Callable[[Sequence[np.ndarray]], list[np.ndarray]]:
+        chosen = [j for j in range(n_runs) if j != i]
+        return lambda thetas: residuals(thetas, chosen)
+
+    fits = [_least_squares(leaving_out(i), solution).x for i in range(n_runs)]
     spread = np.asarray(fits) - np.mean(fits, axis=0)
     return np.sqrt((n_runs - 1) / n_runs * np.sum(spread ** 2, axis=0))

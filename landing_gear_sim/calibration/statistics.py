@@ -35,6 +35,12 @@ def lag_one_correlation(residual: np.ndarray) -> float:
     return float(centred[1:] @ centred[:-1]) / power if power > 0 else 0.0
 
 
+def effective_count(residual: np.ndarray) -> float:
+    """Samples worth of independent information: n (1 − ρ₁)/(1 + ρ₁) (AR(1) residual)."""
+    rho = float(np.clip(lag_one_correlation(residual), 0.0, 0.999))
+    return max(len(residual) * (1 - rho) / (1 + rho), 2.0)
+
+
 def correlation_inflation(residual: np.ndarray) -> float:
     """Variance factor (1 + ρ)/(1 − ρ) for residuals with lag-1 correlation ρ (AR(1)).
 

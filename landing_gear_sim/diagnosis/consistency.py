@@ -35,6 +35,7 @@ from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.plausibility import counted_wheel_step
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.statistics import (
+    effective_count,
     inverse_variance_weights,
     linear_std,
     weighted_least_squares,
@@ -60,7 +61,6 @@ from landing_gear_sim.diagnosis.relations import (
     Relation,
     violations,
 )
-from landing_gear_sim.diagnosis.scoring import effective_count
 from landing_gear_sim.diagnosis.settled_valve import (
     PRESSURE_FLOOR_PA,
     SETTLED_S,

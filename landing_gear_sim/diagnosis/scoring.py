@@ -28,7 +28,7 @@ from landing_gear_sim.calibration.runs import (
     family_of,
     select,
 )
-from landing_gear_sim.calibration.statistics import lag_one_correlation
+from landing_gear_sim.calibration.statistics import effective_count
 from landing_gear_sim.diagnosis.catalogue import (
     Candidate,
     CandidateFit,
@@ -84,12 +84,6 @@ def _pooled_squares(runs: Sequence[Run], simulated: Sequence[Run], channels: Seq
             errors[c] += float(np.sum((y - model) ** 2))
             spreads[c] += float(np.sum((y - y.mean()) ** 2))
     return errors, spreads, sum(len(run) for run in runs)
-
-
-def effective_count(residual: np.ndarray) -> float:
-    """Samples worth of independent information: n (1 − ρ₁)/(1 + ρ₁) (AR(1) residual)."""
-    rho = float(np.clip(lag_one_correlation(residual), 0.0, 0.999))
-    return max(len(residual) * (1 - rho) / (1 + rho), 2.0)
 
 
 def log_ratio(candidate: np.ndarray, null: np.ndarray) -> float:

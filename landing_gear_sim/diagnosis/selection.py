@@ -20,8 +20,8 @@ from typing import Any, Generic, TypeVar
 
 import numpy as np
 
+from landing_gear_sim.calibration.statistics import effective_count
 from landing_gear_sim.diagnosis.relations import Z_VIOLATED
-from landing_gear_sim.diagnosis.scoring import effective_count
 from landing_gear_sim.diagnosis.sparse import sparse_coefficients
 from landing_gear_sim.diagnosis.terms import TermLibrary, coefficient_unit
 from landing_gear_sim.model import basis

@@ -200,6 +200,7 @@ def _jackknife_std(residuals: Callable[[Sequence[np.ndarray], Sequence[int]],
     """Leave-one-run-out spread of the fit: run-to-run variability the residuals hide."""
     if n_runs < 3:
         return np.zeros_like(solution)
+
     def leaving_out(i: int) -> Callable[[Sequence[np.ndarray]], list[np.ndarray]]:
         chosen = [j for j in range(n_runs) if j != i]
         return lambda thetas: residuals(thetas, chosen)

@@ -11,8 +11,14 @@ follows it (a 1-ulp step once moved a fade's fit to another optimum).
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import TypeVar
 
 import numpy as np
+
+from landing_gear_sim.processes import map_threads
+
+Set = TypeVar("Set")
+Item = TypeVar("Item")
 
 DIFF_STEP = 1e-4  # relative, as scipy's diff_step (the fits were tuned with it)
 
@@ -37,7 +43,7 @@ class Objective:
         return value
 
     def jac(self, u: np.ndarray) -> np.ndarray:
-        f0 = self._last[1] if self._last and self._last[0] == u.tobytes() else self.fun(u)
+        f0 = self.fun(u)
         steps = forward_steps(u, *self._bounds)
         points = [u.copy() for _ in range(u.size)]
         for j, point in enumerate(points):
@@ -62,3 +68,13 @@ def forward_steps(u: np.ndarray, lower: float = 0.0, upper: float = 1.0) -> np.n
     fitting = steps <= np.maximum(below, above)
     steps = np.where((u + steps > upper) & fitting, -steps, steps)
     return np.where(fitting, steps, np.where(above >= below, above, -below))
+
+
+def side_by_side(error: Callable[[Set, Item], np.ndarray], sets: Sequence[Set],
+                 items: Sequence[Item]) -> list[np.ndarray]:
+    """Each of ``sets``' errors over ``items``, concatenated in their order: every
+    (set, item) on the cores side by side, each reduced to its error as it comes (a
+    Jacobian's simulated runs are never held all at once)."""
+    errors = map_threads(lambda pair: error(*pair), [(s, i) for s in sets for i in items])
+    n = len(items)
+    return [np.concatenate(errors[k * n:(k + 1) * n]) for k in range(len(sets))]

@@ -10,7 +10,7 @@ import numpy as np
 from scipy.optimize import OptimizeResult, least_squares
 
 from landing_gear_sim.calibration.braking import LOADED_N, Braking, hub_speed
-from landing_gear_sim.calibration.differences import Objective
+from landing_gear_sim.calibration.differences import Objective, side_by_side
 from landing_gear_sim.calibration.measured import simulate_run
 from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
 from landing_gear_sim.calibration.slots import Slot
@@ -21,7 +21,6 @@ from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.elements import MIN_HUB_SPEED_M_S, burckhardt_mu, slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import friction_at, load_factor_at, rolling_radius_at
-from landing_gear_sim.processes import map_threads
 from msg_tools.run import Run
 
 KEYS = (K.FRICTION_THETA1, K.FRICTION_THETA2, K.FRICTION_THETA3)
@@ -151,20 +150,15 @@ def refine_friction(runs: Sequence[ClassifiedRun], p: RigParameters, jackknife: 
         flywheel = simulated.flywheel_speed_rad_s[window] - run.flywheel_speed_rad_s[window]
         return (wheel - ratio * flywheel)[::5]
 
+    def error(trial: RigParameters, i: int) -> np.ndarray:
+        ratio = trial.number(K.FLYWHEEL_RADIUS_M) / trial.number(K.WHEEL_UNLOADED_RADIUS_M)
+        simulated, _ = simulate_run(runs[i], trial)
+        return weights[i] * slip_error(runs[i], simulated, windows[i], ratio)
+
     def residuals(thetas: Sequence[np.ndarray], chosen: Sequence[int]) -> list[np.ndarray]:
         # every (θ, run) simulated side by side: a Jacobian's columns share the cores
-        trials = [p.replace(dict(zip(keys, theta * start, strict=True)), "identify")
-                  for theta in thetas]
-
-        def error(pair: tuple[RigParameters, int]) -> np.ndarray:
-            trial, i = pair
-            ratio = trial.number(K.FLYWHEEL_RADIUS_M) / trial.number(K.WHEEL_UNLOADED_RADIUS_M)
-            simulated, _ = simulate_run(runs[i], trial)
-            return weights[i] * slip_error(runs[i], simulated, windows[i], ratio)
-
-        errors = map_threads(error, [(trial, i) for trial in trials for i in chosen])
-        n = len(chosen)
-        return [np.concatenate(errors[j * n:(j + 1) * n]) for j in range(len(trials))]
+        return side_by_side(error, [p.replace(dict(zip(keys, theta * start, strict=True)),
+                                              "identify") for theta in thetas], chosen)
 
     fit = _least_squares(lambda thetas: residuals(thetas, range(len(runs))), np.ones(3),
                          REFINE_ITERATIONS)

@@ -8,9 +8,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from landing_gear_sim.calibration.differences import side_by_side
 from landing_gear_sim.calibration.measured import simulate_run
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.processes import map_threads
 from msg_tools.run import Run
 
 Scales = dict[tuple[str, str], float]
@@ -28,12 +28,8 @@ def scaled_error(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequen
 def scaled_residuals(runs: Sequence[Run], sets: Sequence[RigParameters],
                      channels: Sequence[str], scales: Scales) -> list[np.ndarray]:
     """:func:`scaled_error` of each parameter set of ``sets``, every (set, run) simulated
-    side by side, each simulation reduced to its error as it comes (a Jacobian's
-    simulated runs are never held all at once)."""
-    def error(pair: tuple[RigParameters, Run]) -> np.ndarray:
-        params, run = pair
+    side by side."""
+    def error(params: RigParameters, run: Run) -> np.ndarray:
         return scaled_error([run], [simulate_run(run, params)[0]], channels, scales)
 
-    errors = map_threads(error, [(params, run) for params in sets for run in runs])
-    n = len(runs)
-    return [np.concatenate(errors[i * n:(i + 1) * n]) for i in range(len(sets))]
+    return side_by_side(error, sets, runs)

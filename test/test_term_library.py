@@ -12,11 +12,14 @@ import pytest
 
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
+from landing_gear_sim.calibration.identify import identify
 from landing_gear_sim.calibration.logger import Logger
 from landing_gear_sim.calibration.runs import classify_all
 from landing_gear_sim.calibration.slots import SEES, Slot
 from landing_gear_sim.diagnosis import equation_library as eq
 from landing_gear_sim.diagnosis.diagnose import diagnose
+from landing_gear_sim.diagnosis.library import Campaign
+from landing_gear_sim.diagnosis.start import starting_model
 from landing_gear_sim.diagnosis.terms import (
     Shaped,
     Without,
@@ -500,3 +503,22 @@ def test_every_relation_checks_the_one_equation_that_declares_it():
     assert sorted(declared) == sorted(Relation) and len(declared) == len(set(declared))
     for library in eq.LIBRARIES:
         assert declaring(library.relation) is library.equation, library
+
+
+def test_a_valves_second_stage_stands_out_of_a_log_that_lost_samples_across_a_step(
+        reference, tmp_path):
+    """Issue 41, sweep campaign 1663 (`none`): every run lost 50 ms, and in the steps run the
+    loss fell on a step. The line bridging it was an error of the whole step (1.8 MPa),
+    which no term of A(s) is; its structure took the σ of A(s)'s check, and a second stage
+    that reads 15 kPa at 25σ read 17.6 kPa at 3.6σ. The test draws the stage; A(s)'s check
+    must see it beyond its noise and its floor."""
+    rng = np.random.default_rng(1663)
+    law = basis.factor_code(basis.VALVE_ERROR, basis.DEAD_ZONE)
+    rig = _with_terms(rig_like(reference, rng), Slot.VALVE, [(law, float(rng.uniform(0.3, 0.6)))])
+    generate_campaign(tmp_path, rig, 1663, ("actuator_ramp", "actuator_steps_sweep"),
+                      logger=Logger(dropout_s=0.05))
+    runs = classify_all(read_campaign(tmp_path).runs)
+    assert any(r.bridged is not None for r in runs)
+    calibrated = identify(runs, starting_model(reference, ()), jackknife=False).params
+    check = eq.VALVE_DYNAMICS.check(Campaign(runs, []), calibrated)
+    assert check is not None and check.violated, check

@@ -64,7 +64,8 @@ def settled_valve(run: ClassifiedRun, params: RigParameters) -> Settled | None:
     slow = np.convolve(fast, np.ones(window), mode="full")[:fast.size] == 0
     band = (model > 2 * PRESSURE_FLOOR_PA) & (model < 0.9 * params.number(
         K.ACTUATOR_MAX_PRESSURE_PA))
-    return Settled(current, model, residual, np.sign(change[last]), slow & band,
+    # the samples the logger lost are a line drawn through them, not the valve
+    return Settled(current, model, residual, np.sign(change[last]), slow & band & run.compared,
                    run.rate_hz, run.time_s - run.time_s[0])
 
 

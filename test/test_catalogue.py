@@ -101,6 +101,13 @@ def test_a_fits_jacobian_is_scipys_forward_difference_within_its_bounds():
         theirs = approx_derivative(values, u, method="2-point", rel_step=DIFF_STEP,
                                    bounds=(0.2, 5.0))
         assert np.array_equal(within.jac(u), theirs)
+    # where a fit before ended (a probe's optimum): its Jacobian given back, layout and all
+    u = np.array([0.3, 0.1, 0.8, 0.6])
+    known = Objective(residuals, known=(u, values(u), objective.jac(u)))
+    calls.clear()
+    again = known.jac(u.copy())
+    assert calls == [] and np.array_equal(again, objective.jac(u))
+    assert again.flags.f_contiguous
 
 
 def _valley(structure: np.ndarray):
@@ -195,3 +202,31 @@ def test_a_pool_task_takes_the_cores_the_pools_other_tasks_leave(monkeypatch):
     monkeypatch.setattr(processes, "_BUSY", None)
     monkeypatch.setattr(processes, "_THREADS", 1)
     assert processes.threads() == 1  # a worker of a pool that shares no count
+
+
+def _counting(monkeypatch) -> list[bytes]:
+    """The parameter sets the candidate fits simulate, in order, as bytes."""
+    from landing_gear_sim.diagnosis import catalogue
+
+    simulated: list[bytes] = []
+    original = catalogue.scaled_residuals
+
+    def counted(runs, trials, *args, **kwargs):
+        simulated.extend(t.vector().tobytes() for t in trials)
+        return original(runs, trials, *args, **kwargs)
+
+    monkeypatch.setattr(catalogue, "scaled_residuals", counted)
+    return simulated
+
+
+def test_a_fit_simulates_its_start_once(reference, tmp_path, monkeypatch):
+    """The starts are simulated to rank them; the optimiser then asked for the chosen one's
+    residual again (and the final fit for the best probe's), a campaign simulation each for
+    nothing."""
+    runs, _ = _hidden(reference, tmp_path, 26, lambda rng: {
+        "elements.actuator_delay": True, "actuator.delay_s": 0.008}, ACTUATOR_RUNS)
+    calibrated = identify(runs, reference).params
+    simulated = _counting(monkeypatch)
+    fit_candidate(CATALOGUE["actuator_delay"], runs, calibrated)
+    assert len(set(simulated)) == len(simulated) > 8
+

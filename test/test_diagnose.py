@@ -599,3 +599,21 @@ def test_a_verdict_of_none_shows_no_empty_findings_table(reference, tmp_path):
     page = write_diagnosis_report(result, tmp_path).read_text()
     verdict = page[page.index("<h2>Verdict"):page.index("<h2>", page.index("<h2>Verdict") + 1)]
     assert "nothing is missing" in verdict and "<table" not in verdict
+
+
+def test_each_models_relations_are_checked_once_the_rounds_computing_them_as_they_fit(
+        monkeypatch):
+    """The checks of the calibrated model (and of the final one) were computed after the
+    rounds, in series, 1.6 s of I02's diagnosis; a round now computes its model's while
+    its candidates fit, and what a round computed is not computed again."""
+    from landing_gear_sim.diagnosis import diagnose as d
+
+    calls: list[object] = []
+    monkeypatch.setattr(d, "check_campaign", lambda runs, model: calls.append(model) or [model])
+    consistency = d.Consistency([])
+    calibrated, extended = object(), object()
+    ran = d._score_all([], [], calibrated, calibrated, {}, [], lambda _: None,
+                       consistency.meanwhile(calibrated))
+    assert ran == [] and calls == [calibrated]  # with nothing to fit, all the same
+    assert consistency.of(extended) == [extended] and consistency.of(calibrated) == [calibrated]
+    assert calls == [calibrated, extended]

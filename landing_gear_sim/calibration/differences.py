@@ -27,13 +27,24 @@ class Objective:
     """Residuals on a box (``residuals`` of many points at once, default box the unit one)
     for ``least_squares``: ``fun`` one point, ``jac`` its forward differences (the residual
     at the point is the one ``fun`` just gave: the optimiser asks for a Jacobian where it
-    evaluated last)."""
+    evaluated last). ``known``: where a fit that went before ended, a point with its residual
+    and, when it has one, its Jacobian (a start the ranking simulated; the best probe's
+    optimum), which ``fun`` and ``jac`` give without simulating them again."""
 
     def __init__(self, residuals: Callable[[Sequence[np.ndarray]], list[np.ndarray]],
-                 lower: float = 0.0, upper: float = 1.0) -> None:
+                 lower: float = 0.0, upper: float = 1.0,
+                 known: tuple[np.ndarray, np.ndarray, np.ndarray | None] | None = None
+                 ) -> None:
         self._residuals = residuals
         self._bounds = (lower, upper)
         self._last: tuple[bytes, np.ndarray] | None = None
+        self._known_jac: tuple[bytes, np.ndarray] | None = None
+        if known is not None:
+            point, value, jacobian = known
+            self._last = (point.tobytes(), value.copy())
+            if jacobian is not None:
+                # in its layout: the solver's rounding follows it (see below)
+                self._known_jac = (point.tobytes(), jacobian.copy(order="K"))
 
     def fun(self, u: np.ndarray) -> np.ndarray:
         if self._last and self._last[0] == u.tobytes():  # asked at a start, then by scipy
@@ -43,6 +54,8 @@ class Objective:
         return value
 
     def jac(self, u: np.ndarray) -> np.ndarray:
+        if self._known_jac and self._known_jac[0] == u.tobytes():
+            return self._known_jac[1].copy(order="K")
         f0 = self.fun(u)
         steps = forward_steps(u, *self._bounds)
         points = [u.copy() for _ in range(u.size)]

@@ -277,19 +277,21 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
                                     *(r.number(k) for k in free)]))
               for s in own_starts for r in references]
     # a start the model does not survive (an unstable valve: inf or nan) is no start
+    at_points = residuals(points)
     initial = [cost if math.isfinite(cost := float(np.sum(r ** 2))) else math.inf
-               for r in residuals(points)]
+               for r in at_points]
     if not math.isfinite(min(initial)):
         raise IdentificationError(f"{candidate.cause}: the model diverges from every start")
     order = [i for i in np.argsort(initial)[:tries] if initial[i] <= START_RATIO * min(initial)]
-    start = points[order[0]]
+    start = (points[order[0]], at_points[order[0]], None)
     if len(order) > 1:
         # successive halving: the starts' first steps tell the basins apart; running each
         # to the end cost twice the time and always ended on the same optimum
-        probes = [_optimise(Objective(residuals), points[i], PROBE_ITERATIONS)
-                  for i in order]
-        start = min(probes, key=lambda fit: fit.cost).x
-    best = _optimise(Objective(residuals), start, MAX_ITERATIONS)
+        probes = [_optimise(Objective(residuals, known=(points[i], at_points[i], None)),
+                            points[i], PROBE_ITERATIONS) for i in order]
+        probe = min(probes, key=lambda fit: fit.cost)
+        start = (probe.x, probe.fun, probe.jac)
+    best = _optimise(Objective(residuals, known=start), start[0], MAX_ITERATIONS)
     values = window.value(best.x)
     std = covariance_std(best, len(keys)) * window.slope(best.x)
     if K.ACTUATOR_DELAY_S in keys:

@@ -12,10 +12,11 @@
 
 from __future__ import annotations
 
+import contextvars
 import multiprocessing
 import os
-from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -116,6 +117,30 @@ class Diagnosis:
                 "datasheet": datasheet_values(self.start)}
 
 
+class Consistency:
+    """The consistency checks of the models a diagnosis reads them under, each computed
+    once (:func:`check_campaign`). A round computes its model's while its candidates fit
+    (:meth:`meanwhile`): the calibrated model's are always read, and the last round's model
+    is the final one."""
+
+    def __init__(self, runs: Sequence[ClassifiedRun]) -> None:
+        self._runs = runs
+        self._done: list[tuple[RigParameters, list[Check]]] = []
+
+    def of(self, model: RigParameters) -> list[Check]:
+        """The checks under ``model``."""
+        for done, checks in self._done:
+            if done is model:
+                return checks
+        checks = check_campaign(self._runs, model)
+        self._done.append((model, checks))
+        return checks
+
+    def meanwhile(self, model: RigParameters) -> Callable[[], object]:
+        """A task computing the checks under ``model``, for :func:`_score_all`."""
+        return lambda: self.of(model)
+
+
 def candidates_for(start: RigParameters, without: Sequence[str]) -> list[Candidate]:
     """Catalogue entries the starting model lacks."""
     return [c for c in CATALOGUE.values()
@@ -159,6 +184,7 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     pending, skipped = _testable(scaled_to_rig(candidates_for(start, without), runs, start),
                                  runs, problems, say)
     model = calibrated
+    consistency = Consistency(runs)
     accepted: list[Scored] = []
     table: list[Finding] = []
     for round_ in range(1, MAX_ROUNDS + 1):
@@ -166,7 +192,8 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
             break
         say(f"round {round_}: fitting {', '.join(c.cause for c in pending)}")
         scored = []
-        for outcome in _score_all(pending, runs, model, base, scales, before, say):
+        for outcome in _score_all(pending, runs, model, base, scales, before, say,
+                                  consistency.meanwhile(model)):
             if isinstance(outcome, str):
                 problems.append(outcome)
             else:
@@ -184,8 +211,7 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
         pending = [CATALOGUE[s.finding.cause] for s in scored
                    if s is not best and (s.finding.delta_bic or 0.0) < 0]
     say("checking the relations the rig measures twice")
-    checks = check_campaign(runs, model)
-    calibrated_checks = checks if model is calibrated else check_campaign(runs, calibrated)
+    checks, calibrated_checks = consistency.of(model), consistency.of(calibrated)
     problems.extend(unchecked_relations(runs, calibrated_checks))
     problems.extend(coarse_channels(runs, calibrated_checks))
     story = discovered.Story(runs, calibrated, base, scales, tried, calibrated_checks, say)
@@ -195,7 +221,7 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
         if found.scored is not None:
             model = found.scored.fit.params
             accepted = [*(_refreshed(s, model) for s in found.kept), found.scored]
-            checks = check_campaign(runs, model)
+            checks = consistency.of(model)
     say("analysing the residuals of the extended model")
     simulated_after = simulate_all(runs, model)
     after = _interpretable(find_signatures(runs, model, simulated_after), runs)
@@ -306,34 +332,44 @@ def _score_one(candidate: Candidate, runs: Sequence[ClassifiedRun], model: RigPa
 
 def _score_all(pending: Sequence[Candidate], runs: Sequence[ClassifiedRun], model: RigParameters,
                datasheet: RigParameters, scales: Scales, signatures: Sequence[Signature],
-               say: Progress) -> list[Scored | str]:
+               say: Progress, meanwhile: Callable[[], object] = lambda: None
+               ) -> list[Scored | str]:
     """Score the candidates, in parallel processes when there are cores to spare (each
-    fit is independent and single-threaded); in order of ``pending``."""
+    fit is independent and single-threaded); in order of ``pending``. ``meanwhile`` runs
+    in this process as they fit (its work is serial: the fits' threads leave room for it)."""
     workers = min(len(pending), os.cpu_count() or 1)
     if workers < 2 or multiprocessing.current_process().daemon:
         # a daemonic process (a Dask worker's) may not have children
+        meanwhile()
         return [_score_one(c, runs, model, datasheet, scales, signatures) for c in pending]
     # fork: the children inherit the compiled physics instead of compiling it again
     context = multiprocessing.get_context("fork")
     pool = ProcessPoolExecutor(workers, mp_context=context, initializer=pool_worker,
                                initargs=(busy_counter(),))
+    side = ThreadPoolExecutor(1)
     try:
         # the costliest first (more fitted parameters: more simulations per step), so the
         # last to finish is a short one
         futures = {pool.submit(_score_one, c, runs, model, datasheet, scales, signatures): c
                    for c in sorted(pending, key=lambda c: -len({*c.keys, *c.free}))}
+        # on a thread only once the workers are forked: a fork while it holds a lock (an
+        # import's) would leave the child waiting on it; numpy's error state goes with it
+        beside = side.submit(contextvars.copy_context().run, meanwhile)
         for future in as_completed(futures):
             say(f"  {futures[future].cause} scored")
         results = [next(f for f, c in futures.items() if c is candidate).result()
                    for candidate in pending]
+        beside.result()
     except BaseException:
         # Ctrl-C or SIGTERM: the workers' fits could run for minutes; an executor's exit
         # would wait for them
         for child in multiprocessing.active_children():
             child.terminate()
         pool.shutdown(wait=False, cancel_futures=True)
+        side.shutdown(wait=False, cancel_futures=True)
         raise
     pool.shutdown()
+    side.shutdown()
     return results
 
 

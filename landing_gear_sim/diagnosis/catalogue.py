@@ -11,7 +11,7 @@ the measurement itself.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -234,7 +234,8 @@ def switched_on(candidate: Candidate, params: RigParameters) -> RigParameters:
 
 def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters,
                   datasheet: RigParameters | None = None, *, null: bool = False,
-                  tries: int = 2, scales: Scales | None = None) -> CandidateFit:
+                  tries: int = 2, scales: Scales | None = None,
+                  ended: Mapping[str, float] | None = None) -> CandidateFit:
     """Switch ``candidate`` on in ``base`` and fit its keys plus its free base parameters
     on the runs of its kinds among ``runs``.
 
@@ -245,7 +246,10 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
     the best (a start further off ended no better in any campaign tried) each take
     ``PROBE_ITERATIONS`` steps; the best of them goes on, within ``MAX_ITERATIONS`` steps
     (the evaluation budget: a fit is bounded in time). ``null=True`` fits the free
-    parameters alone, element off: the fair reference for the candidate.
+    parameters alone, element off: the fair reference for the candidate. ``ended``: the
+    values its parameters ended at when it was fitted before (a round earlier, on a model
+    without what was accepted since): one more start, which goes on alone when it ranks
+    first.
     """
     chosen = select(classify_all(runs), candidate.runs)
     if not chosen:
@@ -276,6 +280,12 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
     points = [window.unit(np.array([*(s or [r.number(k) for k in own]),
                                     *(r.number(k) for k in free)]))
               for s in own_starts for r in references]
+    resumed = bool(own and ended)
+    if resumed:
+        # where it ended, its free parameters with its keys (a delay ended beside the ω_n
+        # it moved; beside the calibrated ω_n it started worse than the catalogue's)
+        points.insert(0, window.unit(np.array([(ended or {}).get(k, model.number(k))
+                                               for k in keys])))
     # a start the model does not survive (an unstable valve: inf or nan) is no start
     at_points = residuals(points)
     initial = [cost if math.isfinite(cost := float(np.sum(r ** 2))) else math.inf
@@ -283,6 +293,8 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
     if not math.isfinite(min(initial)):
         raise IdentificationError(f"{candidate.cause}: the model diverges from every start")
     order = [i for i in np.argsort(initial)[:tries] if initial[i] <= START_RATIO * min(initial)]
+    if resumed and order[0] == 0:
+        order = order[:1]  # its probes told the basins apart when it was fitted before
     start = (points[order[0]], at_points[order[0]], None)
     if len(order) > 1:
         # successive halving: the starts' first steps tell the basins apart; running each

@@ -15,7 +15,7 @@ from __future__ import annotations
 import contextvars
 import multiprocessing
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field, replace
 
@@ -187,13 +187,14 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     consistency = Consistency(runs)
     accepted: list[Scored] = []
     table: list[Finding] = []
+    ended: dict[str, dict[str, float]] = {}  # where each candidate's fit ended, by cause
     for round_ in range(1, MAX_ROUNDS + 1):
         if not pending:
             break
         say(f"round {round_}: fitting {', '.join(c.cause for c in pending)}")
         scored = []
         for outcome in _score_all(pending, runs, model, base, scales, before, say,
-                                  consistency.meanwhile(model)):
+                                  consistency.meanwhile(model), ended):
             if isinstance(outcome, str):
                 problems.append(outcome)
             else:
@@ -208,6 +209,7 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
         accepted.append(best)
         say(f"re-calibrating with {', '.join(s.finding.cause for s in accepted)}")
         model, accepted = _recalibrate(runs, start, accepted, without)
+        ended = {s.finding.cause: s.fit.values for s in scored}
         pending = [CATALOGUE[s.finding.cause] for s in scored
                    if s is not best and (s.finding.delta_bic or 0.0) < 0]
     say("checking the relations the rig measures twice")
@@ -322,26 +324,30 @@ def _unsettled_in_time(table: Sequence[Finding]) -> list[str]:
 
 def _score_one(candidate: Candidate, runs: Sequence[ClassifiedRun], model: RigParameters,
                datasheet: RigParameters, scales: Scales,
-               signatures: Sequence[Signature]) -> Scored | str:
+               signatures: Sequence[Signature], ended: Mapping[str, float] | None = None
+               ) -> Scored | str:
     try:
         with working():
-            return score_candidate(candidate, runs, model, datasheet, scales, signatures)
+            return score_candidate(candidate, runs, model, datasheet, scales, signatures,
+                                   ended=ended)
     except IdentificationError as exc:
         return f"{candidate.cause}: not scored ({exc})"
 
 
 def _score_all(pending: Sequence[Candidate], runs: Sequence[ClassifiedRun], model: RigParameters,
                datasheet: RigParameters, scales: Scales, signatures: Sequence[Signature],
-               say: Progress, meanwhile: Callable[[], object] = lambda: None
-               ) -> list[Scored | str]:
+               say: Progress, meanwhile: Callable[[], object] = lambda: None,
+               ended: Mapping[str, Mapping[str, float]] | None = None) -> list[Scored | str]:
     """Score the candidates, in parallel processes when there are cores to spare (each
-    fit is independent and single-threaded); in order of ``pending``. ``meanwhile`` runs
+    fit is independent and single-threaded), each from where it ``ended`` in a round before
+    as well (by cause); in order of ``pending``. ``meanwhile`` runs
     in this process as they fit (its work is serial: the fits' threads leave room for it)."""
     workers = min(len(pending), os.cpu_count() or 1)
     if workers < 2 or multiprocessing.current_process().daemon:
         # a daemonic process (a Dask worker's) may not have children
         meanwhile()
-        return [_score_one(c, runs, model, datasheet, scales, signatures) for c in pending]
+        return [_score_one(c, runs, model, datasheet, scales, signatures,
+                           (ended or {}).get(c.cause)) for c in pending]
     # fork: the children inherit the compiled physics instead of compiling it again
     context = multiprocessing.get_context("fork")
     pool = ProcessPoolExecutor(workers, mp_context=context, initializer=pool_worker,
@@ -350,7 +356,8 @@ def _score_all(pending: Sequence[Candidate], runs: Sequence[ClassifiedRun], mode
     try:
         # the costliest first (more fitted parameters: more simulations per step), so the
         # last to finish is a short one
-        futures = {pool.submit(_score_one, c, runs, model, datasheet, scales, signatures): c
+        futures = {pool.submit(_score_one, c, runs, model, datasheet, scales, signatures,
+                               (ended or {}).get(c.cause)): c
                    for c in sorted(pending, key=lambda c: -len({*c.keys, *c.free}))}
         # on a thread only once the workers are forked: a fork while it holds a lock (an
         # import's) would leave the child waiting on it; numpy's error state goes with it

@@ -14,7 +14,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -194,11 +194,12 @@ def _names(runs: Sequence[Run]) -> tuple[str, ...]:
 
 def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParameters,
                     datasheet: RigParameters, scales: Scales,
-                    signatures: Sequence[Signature], start: RigParameters | None = None
-                    ) -> Scored:
+                    signatures: Sequence[Signature], start: RigParameters | None = None,
+                    ended: Mapping[str, float] | None = None) -> Scored:
     """Fit ``candidate`` and its null on the fitting runs; compare both on held-out runs.
     The candidate's fit starts from ``start`` when given (a model calibrated again with
-    it), its null's from ``model`` (the best the runs give without it)."""
+    it), and from where it ``ended`` when fitted before; its null's from ``model`` (the
+    best the runs give without it)."""
     fit_runs, held_runs = split_runs(candidate, runs)
     scales = {**scales, **{(part.name, channel): value for part in (*fit_runs, *held_runs)
                            for (name, channel), value in scales.items()
@@ -207,7 +208,8 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
     if candidate.settings:
         model = model.replace(dict(candidate.settings), f"{candidate.family}'s terms")
         start = start and start.replace(dict(candidate.settings), f"{candidate.family}'s terms")
-    with_it = fit_candidate(sub, fit_runs, start or model, datasheet, scales=scales)
+    with_it = fit_candidate(sub, fit_runs, start or model, datasheet, scales=scales,
+                            ended=ended)
     without = _null_fit(sub, fit_runs, model, datasheet, scales)
     if candidate.neutral and with_it.cost > without.cost:
         with_it = _from_null(sub, fit_runs, without, scales)

@@ -339,9 +339,9 @@ def _score_all(pending: Sequence[Candidate], runs: Sequence[ClassifiedRun], mode
                say: Progress, meanwhile: Callable[[], object] = lambda: None,
                ended: Mapping[str, Mapping[str, float]] | None = None) -> list[Scored | str]:
     """Score the candidates, in parallel processes when there are cores to spare (each
-    fit is independent and single-threaded), each from where it ``ended`` in a round before
-    as well (by cause); in order of ``pending``. ``meanwhile`` runs
-    in this process as they fit (its work is serial: the fits' threads leave room for it)."""
+    fit is independent and single-threaded), each also from where it ``ended`` in a round
+    before (by cause); in order of ``pending``. ``meanwhile`` runs in this process as they
+    fit (its work is serial: the fits' threads leave room for it)."""
     workers = min(len(pending), os.cpu_count() or 1)
     if workers < 2 or multiprocessing.current_process().daemon:
         # a daemonic process (a Dask worker's) may not have children

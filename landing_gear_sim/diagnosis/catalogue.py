@@ -280,12 +280,10 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
     points = [window.unit(np.array([*(s or [r.number(k) for k in own]),
                                     *(r.number(k) for k in free)]))
               for s in own_starts for r in references]
-    resumed = bool(own and ended)
-    if resumed:
+    if own and ended:
         # where it ended, its free parameters with its keys (a delay ended beside the ω_n
         # it moved; beside the calibrated ω_n it started worse than the catalogue's)
-        points.insert(0, window.unit(np.array([(ended or {}).get(k, model.number(k))
-                                               for k in keys])))
+        points.insert(0, window.unit(np.array([ended.get(k, model.number(k)) for k in keys])))
     # a start the model does not survive (an unstable valve: inf or nan) is no start
     at_points = residuals(points)
     initial = [cost if math.isfinite(cost := float(np.sum(r ** 2))) else math.inf
@@ -293,7 +291,7 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
     if not math.isfinite(min(initial)):
         raise IdentificationError(f"{candidate.cause}: the model diverges from every start")
     order = [i for i in np.argsort(initial)[:tries] if initial[i] <= START_RATIO * min(initial)]
-    if resumed and order[0] == 0:
+    if own and ended and order[0] == 0:
         order = order[:1]  # its probes told the basins apart when it was fitted before
     start = (points[order[0]], at_points[order[0]], None)
     if len(order) > 1:

@@ -342,12 +342,13 @@ def _score_all(pending: Sequence[Candidate], runs: Sequence[ClassifiedRun], mode
     fit is independent and single-threaded), each also from where it ``ended`` in a round
     before (by cause); in order of ``pending``. ``meanwhile`` runs in this process as they
     fit (its work is serial: the fits' threads leave room for it)."""
+    ended = ended or {}
     workers = min(len(pending), os.cpu_count() or 1)
     if workers < 2 or multiprocessing.current_process().daemon:
         # a daemonic process (a Dask worker's) may not have children
         meanwhile()
         return [_score_one(c, runs, model, datasheet, scales, signatures,
-                           (ended or {}).get(c.cause)) for c in pending]
+                           ended.get(c.cause)) for c in pending]
     # fork: the children inherit the compiled physics instead of compiling it again
     context = multiprocessing.get_context("fork")
     pool = ProcessPoolExecutor(workers, mp_context=context, initializer=pool_worker,
@@ -357,7 +358,7 @@ def _score_all(pending: Sequence[Candidate], runs: Sequence[ClassifiedRun], mode
         # the costliest first (more fitted parameters: more simulations per step), so the
         # last to finish is a short one
         futures = {pool.submit(_score_one, c, runs, model, datasheet, scales, signatures,
-                               (ended or {}).get(c.cause)): c
+                               ended.get(c.cause)): c
                    for c in sorted(pending, key=lambda c: -len({*c.keys, *c.free}))}
         # on a thread only once the workers are forked: a fork while it holds a lock (an
         # import's) would leave the child waiting on it; numpy's error state goes with it

@@ -50,6 +50,12 @@ MIN_GAIN_POINTS = 0.1
 # channel's error (fit 83 % under the true model through 256 lines), so a 4 ms skew the
 # held-out runs confirmed (by 179) gained 0.09 points as logged; a rig's dynamics lie below
 DENOISED_HZ = 50.0
+# ... and no worse elsewhere: no channel it is compared on may lose more held-out fit than
+# it gains on its best, beyond this many points (a 64-count encoder's campaign named a
+# tyre whose friction peak moves with speed tire_relaxation, held out: the force channel
+# 85.8 → 86.1 %, the wheel's 34.0 → 28.0 %, the log-likelihood better by 64 on the force
+# channel's many more effective samples)
+MAX_LOSS_POINTS = 1.0
 
 
 def channel_fits(runs: Sequence[Run], simulated: Sequence[Run], channels: Sequence[str],
@@ -314,11 +320,25 @@ def _rejection(delta_bic: float, held: HeldOut, at_bound: bool, beyond: str) -> 
     if held.gain < MIN_GAIN_POINTS:
         return (f"no: it gains {held.gain:.2f} fit-% points on the held-out runs' channel it "
                 f"helps most, below {MIN_GAIN_POINTS:g}")
+    if (worse := _worsened(held)):
+        return f"no: {worse}"
     if at_bound:
         return "no: a key parameter sits at the edge of its range"
     if beyond:
         return f"no: {beyond}"
     return ""
+
+
+def _worsened(held: HeldOut) -> str:
+    """The held-out channel a candidate makes worse by more than it gains on its best and
+    more than MAX_LOSS_POINTS, in words ('': none)."""
+    losses = {c: held.before[c] - held.after[c] for c in held.after if c in held.before}
+    channel = max(losses, key=losses.__getitem__, default=None)
+    if channel is None or losses[channel] <= max(held.gain, MAX_LOSS_POINTS):
+        return ""
+    return (f"it makes the held-out runs' {channel} worse by {losses[channel]:.2f} fit-% "
+            f"points ({held.before[channel]:.1f} → {held.after[channel]:.1f} %), more than "
+            f"it makes any channel better (+{held.gain:.2f})")
 
 
 @dataclass(frozen=True)

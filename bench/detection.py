@@ -9,7 +9,9 @@ cause and family, 5 null campaigns and the ten independent ones takes about 20 m
 cores). The campaigns run on Dask, like ``history``: a local cluster
 by default, a real one with ``--scheduler``; every result goes to a journal
 (``out/detection/seed-S.jsonl``) as it comes, so a stopped sweep started again runs only
-the rest.
+the rest. Each row also holds every candidate the diagnosis scored (``candidates``: round,
+ΔBIC, held-out change, verdict and reason, the largest loss and gain of its held-out fits),
+so a sweep tells how near its rules each verdict came.
 
 Each campaign is made by the project's own rig generator: the ordinary datasheet
 deviations and sensor noise, plus one effect drawn at random over a realistic range
@@ -225,11 +227,12 @@ REALITY = 0.3
 
 
 def run_case(cause: str | None, seed: int, datasheet: RigParameters, light: bool = False,
-             realities: bool = False, keep: str | None = None) -> tuple[bool, str, float]:
+             realities: bool = False, keep: str | None = None
+             ) -> tuple[bool, str, float, Diagnosis]:
     """Diagnose one generated campaign (with the light stops when ``light`` or when the
     cause needs them; with ``realities`` as a random logger writes it; kept under ``keep``
     with the parameters that made it, else thrown away); (correct, verdict, key-parameter
-    error)."""
+    error, the diagnosis)."""
     rng = np.random.default_rng(seed)
     rig = rig_like(datasheet, rng)
     if cause in OUTSIDE:
@@ -243,7 +246,13 @@ def run_case(cause: str | None, seed: int, datasheet: RigParameters, light: bool
                           logger=logger)
         runs = read_campaign(folder).runs
     result = diagnose(runs, datasheet, without=list(case.without) if case else [])
-    if case is None:
+    return (*_judged(cause, case, rig, result), result)
+
+
+def _judged(cause: str | None, case: Case | None, rig: RigParameters, result: Diagnosis
+            ) -> tuple[bool, str, float]:
+    """(correct, verdict, key-parameter error) of a diagnosis of ``case`` hidden in ``rig``."""
+    if cause is None or case is None:
         return result.verdict == "none", result.verdict, math.nan
     if cause in FAMILIES:
         family = FAMILIES[cause].family or cause
@@ -257,6 +266,21 @@ def run_case(cause: str | None, seed: int, datasheet: RigParameters, light: bool
     if result.verdict != cause or not found:
         return False, result.verdict, math.nan
     return _within(case, found[0].parameters[_key(case, rig)], rig, result.verdict)
+
+
+def scored(result: Diagnosis) -> list[dict[str, object]]:
+    """Every candidate the diagnosis scored, for the journal: its round, ΔBIC, held-out
+    change, verdict and reason, and the largest loss and gain of its held-out fits [fit-%
+    points] — how near a rule each came (a sweep's margins had been read through a probe)."""
+    rows: list[dict[str, object]] = []
+    for f in result.candidates:
+        changes = [f.fit_after[c] - f.fit_before[c] for c in f.fit_after if c in f.fit_before]
+        rows.append({"cause": f.cause, "family": f.family, "round": f.round,
+                     "delta_bic": f.delta_bic, "held_out": f.held_out,
+                     "accepted": f.accepted, "reason": f.reason,
+                     "loss": round(-min(changes), 2) + 0.0 if changes else None,
+                     "gain": round(max(changes), 2) if changes else None})
+    return rows
 
 
 @contextlib.contextmanager
@@ -275,7 +299,7 @@ def _campaign_folder(keep: str | None, cause: str | None, seed: int) -> Iterator
 
 def _outside(cause: str, rig: RigParameters, rng: np.random.Generator, seed: int,
              datasheet: RigParameters, realities: bool, keep: str | None = None
-             ) -> tuple[bool, str, float]:
+             ) -> tuple[bool, str, float, Diagnosis]:
     """A campaign of an OUTSIDE effect: right when discovered in its equation with a
     held-out gain (no value: the law is none of the library's terms)."""
     equation, draw = OUTSIDE[cause]
@@ -288,7 +312,7 @@ def _outside(cause: str, rig: RigParameters, rng: np.random.Generator, seed: int
     first = result.findings[0] if result.findings else None
     ok = (result.verdict == "discovered" and first is not None and first.family == equation
           and first.held_out is not None and first.held_out < HELD_OUT_THRESHOLD)
-    return ok, _verdict(result), math.nan
+    return ok, _verdict(result), math.nan, result
 
 
 def _verdict(result: Diagnosis) -> str:
@@ -318,7 +342,8 @@ def case_task(cause: str | None, seed: int, light: bool = False, realities: bool
               keep: str | None = None) -> dict:
     """One campaign of the sweep, as a journal row."""
     started = time.perf_counter()
-    ok, verdict, error = run_case(cause, seed, load_parameters(), light, realities, keep)
+    ok, verdict, error, result = run_case(cause, seed, load_parameters(), light, realities,
+                                          keep)
     truth = cause or "none"
     if truth in OUTSIDE:
         truth = f"discovered {OUTSIDE[truth][0]} ({truth})"
@@ -328,7 +353,8 @@ def case_task(cause: str | None, seed: int, light: bool = False, realities: bool
     return {"cause": truth, "seed": str(seed),
             "ok": ok, "verdict": verdict, "error": None if math.isnan(error) else error,
             "logger": ", ".join(random_logger(np.random.default_rng([seed, 2])).realities)
-            if realities else "", "seconds": round(time.perf_counter() - started, 1)}
+            if realities else "", "candidates": scored(result),
+            "seconds": round(time.perf_counter() - started, 1)}
 
 
 def independent_task(folder: str) -> dict:
@@ -341,7 +367,8 @@ def independent_task(folder: str) -> dict:
     errors = [e for e in judged.errors.values() if not math.isnan(e)]
     return {"cause": want.label, "seed": Path(folder).name, "ok": judged.ok,
             "verdict": judged.label, "error": max(errors) if errors else None,
-            "errors": judged.errors, "seconds": round(time.perf_counter() - started, 1)}
+            "errors": judged.errors, "candidates": scored(result),
+            "seconds": round(time.perf_counter() - started, 1)}
 
 
 def unseen_task(folder: str, equation: str) -> dict:
@@ -352,7 +379,7 @@ def unseen_task(folder: str, equation: str) -> dict:
     ok, outcome = independent.judge_unseen(result.to_json(), equation)
     return {"cause": f"{equation} ({Path(folder).name})", "seed": Path(folder).name,
             "ok": ok, "verdict": outcome[:30], "outcome": outcome, "error": None,
-            "seconds": round(time.perf_counter() - started, 1)}
+            "candidates": scored(result), "seconds": round(time.perf_counter() - started, 1)}
 
 
 def datasheet_task(folder: str) -> dict:
@@ -367,7 +394,7 @@ def datasheet_task(folder: str) -> dict:
         result.extended.number(K.ACTUATOR_DAMPING_RATIO), Path(folder))
     return {"cause": f"datasheet ({Path(folder).name})", "seed": Path(folder).name,
             "ok": ok, "verdict": outcome[:30], "outcome": outcome, "error": None,
-            "seconds": round(time.perf_counter() - started, 1)}
+            "candidates": scored(result), "seconds": round(time.perf_counter() - started, 1)}
 
 
 def _line(row: dict) -> str:

@@ -252,7 +252,7 @@ def run_case(cause: str | None, seed: int, datasheet: RigParameters, light: bool
 def _judged(cause: str | None, case: Case | None, rig: RigParameters, result: Diagnosis
             ) -> tuple[bool, str, float]:
     """(correct, verdict, key-parameter error) of a diagnosis of ``case`` hidden in ``rig``."""
-    if cause is None or case is None:
+    if case is None:  # no cause hidden (a null), or one the sweep does not know
         return result.verdict == "none", result.verdict, math.nan
     if cause in FAMILIES:
         family = FAMILIES[cause].family or cause

@@ -56,6 +56,8 @@ LOST_PEER_EXIT = 3
 """Exit code of a plant whose run lost a participant (held its input): never a success."""
 NOT_STARTED_EXIT = 4
 """Exit code of a plant whose run could not start (a participant missing)."""
+RECORDER = "recorder"
+"""The node that writes the bag: the one with work left once the plant ends the run."""
 NAMESPACE_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*")
 """A ROS namespace without its leading '/' (what ``-r __ns:=/...`` and launch accept)."""
 EXTERNAL = "external"
@@ -241,7 +243,7 @@ def describe(options: GraphOptions) -> list[NodeSpec]:
     else:
         nodes.append(NodeSpec("profile", {**run, **shared}, (TOPIC_CURRENT,), (TOPIC_WHEEL,)))
     if options.bag is not None:
-        nodes.append(NodeSpec("recorder", {**shared, "bag": str(options.bag),
+        nodes.append(NodeSpec(RECORDER, {**shared, "bag": str(options.bag),
                                            "storage": options.storage},
                               (), RECORDED_TOPICS))
     clock = ((TOPIC_CLOCK, options.clock_topic),) if options.clock_topic != TOPIC_CLOCK else ()

@@ -19,7 +19,15 @@ from pathlib import Path
 from landing_gear_sim.errors import GraphError
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.processes import die_with_parent
-from landing_gear_sim.ros.graph import GraphOptions, NodeSpec, ParamValue, describe
+from landing_gear_sim.ros.graph import (
+    LOST_PEER_EXIT,
+    NOT_STARTED_EXIT,
+    RECORDER,
+    GraphOptions,
+    NodeSpec,
+    ParamValue,
+    describe,
+)
 
 LINGER_S = 10.0  # after the plant ends, how long the others may take to finish on their own
 STOP_S = 5.0  # after SIGINT, how long before SIGKILL
@@ -112,7 +120,7 @@ def _run_processes(options: GraphOptions, params_file: Path,
                                                     preexec_fn=_node_process)
         failed = _wait_for_plant(processes, say, stop)
         if failed is None:
-            _wait_all(processes, LINGER_S, stop)
+            _wait_all(_finishing(processes), LINGER_S, stop)
     finally:
         _stop(processes)  # a second Ctrl-C meanwhile is only noted: the bag is being closed
         for sig, handler in previous.items():
@@ -162,6 +170,18 @@ def _wait_for_plant(processes: dict[str, subprocess.Popen], say: Callable[[str],
                 return name
         time.sleep(0.05)
     return None
+
+
+def _finishing(processes: dict[str, subprocess.Popen]) -> dict[str, subprocess.Popen]:
+    """The nodes the plant's end leaves work to finish on their own: every node after a
+    complete run; only the recorder (its bag) after a run that lost a node, which would be
+    waited for in vain (a stopped actuator: LINGER_S); none when the run never started."""
+    code = processes["plant"].returncode
+    if code == NOT_STARTED_EXIT:
+        return {}
+    if code == LOST_PEER_EXIT:
+        return {name: p for name, p in processes.items() if name == RECORDER}
+    return processes
 
 
 def _wait_all(processes: dict[str, subprocess.Popen], timeout_s: float,

@@ -23,6 +23,7 @@ import time
 import numpy as np
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Vector3Stamped, WrenchStamped
+from rclpy.duration import Duration
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import FluidPressure, JointState
 from std_msgs.msg import String, UInt64
@@ -318,8 +319,15 @@ class PlantNode(GraphNode):
     def close(self) -> None:
         if not self.context.ok():  # stopped by a signal: the context is gone, nothing to flush
             return
+        # nothing published is lost when the plant leaves; but a lost node never acknowledges,
+        # and the wait lasted until DDS dropped it (16 s after a run with a stopped actuator)
+        deadline = time.monotonic() + self._timeout_s if self._lost else None
         for publisher in (*self._out.values(), self._end):
-            publisher.wait_for_all_acked()  # nothing published is lost when the plant leaves
+            left = -1.0 if deadline is None else max(deadline - time.monotonic(), 0.0)
+            if not publisher.wait_for_all_acked(Duration(seconds=left)):
+                self.get_logger().warning(
+                    f"leaving with {publisher.topic} not acknowledged by every reader within "
+                    f"{self._timeout_s:g} s (a lost node never acknowledges)")
 
 
 class _Messages:

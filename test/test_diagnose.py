@@ -16,6 +16,7 @@ import sys
 import time
 from html.parser import HTMLParser
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -617,3 +618,28 @@ def test_each_models_relations_are_checked_once_the_rounds_computing_them_as_the
     assert ran == [] and calls == [calibrated]  # with nothing to fit, all the same
     assert consistency.of(extended) == [extended] and consistency.of(calibrated) == [calibrated]
     assert calls == [calibrated, extended]
+
+
+def _scored(cause: str, delta_bic: float) -> SimpleNamespace:
+    return SimpleNamespace(finding=SimpleNamespace(cause=cause, delta_bic=delta_bic))
+
+
+def test_a_cause_short_of_the_evidence_on_two_models_in_a_row_is_not_fitted_a_third_time():
+    """I02's third round fitted a fade again (2.1 s) that was short of the evidence beside
+    the delay and again beside the delay and the offset; a cause masked by the round's
+    best gets its one more try (the offset: ΔBIC −46 beside the delay, then −5622)."""
+    from landing_gear_sim.diagnosis.diagnose import tried_again
+
+    best = _scored("actuator_delay", -1667.0)
+    first = [best, _scored("pressure_sensor_offset", -46.0), _scored("brake_fade", -5.0),
+             _scored("tire_relaxation", 7.0)]
+    assert [c.cause for c in tried_again(first, best, set())] == [
+        "pressure_sensor_offset", "brake_fade"]
+    best = _scored("pressure_sensor_offset", -5622.0)
+    second = [best, _scored("brake_fade", -4.0)]
+    assert tried_again(second, best, {"brake_fade"}) == []
+    # short of it only in the round before: it grew beside this round's best
+    assert [c.cause for c in tried_again([best, _scored("brake_fade", -40.0)], best,
+                                         {"brake_fade"})] == ["brake_fade"]
+    # short of it only in this round: tried on the model with this round's best
+    assert [c.cause for c in tried_again(second, best, set())] == ["brake_fade"]

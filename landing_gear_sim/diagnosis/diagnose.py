@@ -188,6 +188,7 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     accepted: list[Scored] = []
     table: list[Finding] = []
     ended: dict[str, dict[str, float]] = {}  # where each candidate's fit ended, by cause
+    weak: set[str] = set()  # the causes short of the evidence in the round before
     for round_ in range(1, MAX_ROUNDS + 1):
         if not pending:
             break
@@ -210,8 +211,8 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
         say(f"re-calibrating with {', '.join(s.finding.cause for s in accepted)}")
         model, accepted = _recalibrate(runs, start, accepted, without)
         ended = {s.finding.cause: s.fit.values for s in scored}
-        pending = [CATALOGUE[s.finding.cause] for s in scored
-                   if s is not best and (s.finding.delta_bic or 0.0) < 0]
+        pending = tried_again(scored, best, weak)
+        weak = {s.finding.cause for s in scored if _short(s)}
     say("checking the relations the rig measures twice")
     checks, calibrated_checks = consistency.of(model), consistency.of(calibrated)
     problems.extend(unchecked_relations(runs, calibrated_checks))
@@ -271,6 +272,26 @@ def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],
         else:
             testable.append(candidate)
     return testable, [c for c in skipped if _could_show(CATALOGUE[c], runs)]
+
+
+def tried_again(scored: Sequence[Scored], best: Scored, weak: set[str]) -> list[Candidate]:
+    """The candidates of a round tried again on the model with its ``best``: every other
+    that fitted better (ΔBIC < 0), but not one short of the evidence (ΔBIC not below the
+    threshold) on two models in a row, this round's and the one before's (``weak``).
+
+    A cause masked by another shows once that one is in (I02's sensor offset: ΔBIC −46
+    beside the delay that masked it, −5622 once the delay was in), so a weak one gets one
+    more try. In the whole plan of bench/detection.py (stop 56) none of the 7 weak ones
+    tried again grew significant, and I02's fade, weak twice, was fitted a third time for
+    2.1 s and refused again."""
+    return [CATALOGUE[s.finding.cause] for s in scored
+            if s is not best and (s.finding.delta_bic or 0.0) < 0
+            and not (_short(s) and s.finding.cause in weak)]
+
+
+def _short(scored: Scored) -> bool:
+    """Whether a scored candidate is short of the evidence: ΔBIC not below the threshold."""
+    return (scored.finding.delta_bic or 0.0) >= BIC_THRESHOLD
 
 
 def _round_reason(scored: Scored, best: Scored | None) -> str:

@@ -21,6 +21,8 @@ from landing_gear_sim.model.runspec import RunSpec, build_scenario
 from landing_gear_sim.ros.graph import (
     EXTERNAL,
     LAUNCH_ARGUMENTS,
+    LOST_PEER_EXIT,
+    NOT_STARTED_EXIT,
     RECORDED_TOPICS,
     TOPIC_CLOCK,
     TOPIC_RUN_END,
@@ -29,7 +31,12 @@ from landing_gear_sim.ros.graph import (
     describe,
     options_from_arguments,
 )
-from landing_gear_sim.ros.launcher import format_value, node_command, ros_environment
+from landing_gear_sim.ros.launcher import (
+    _finishing,
+    format_value,
+    node_command,
+    ros_environment,
+)
 from landing_gear_sim.ros.options import GRAPH_OPTIONS, OPTIONS, given, graph_settings
 from msg_tools.bag_io import TYPESTORE
 from msg_tools.bag_read import read_bag
@@ -161,6 +168,20 @@ def test_the_launcher_leaves_the_users_dds_settings_alone():
     assert "ROS_AUTOMATIC_DISCOVERY_RANGE" not in ros_environment({})
     user = {"ROS_DOMAIN_ID": "173", "ROS_AUTOMATIC_DISCOVERY_RANGE": "SUBNET"}
     assert ros_environment(user).items() >= user.items()
+
+
+def test_after_the_plant_the_launcher_waits_for_the_nodes_with_work_left():
+    """A lost node never ends on its own (a stopped actuator held the launcher 10 s): after
+    such a run only the recorder's bag is waited for, after a run that never started
+    nothing; a stop that came before the plant was started once raised KeyError there."""
+    def nodes(plant_code: int | None) -> dict:
+        return {name: types.SimpleNamespace(returncode=plant_code if name == "plant" else None)
+                for name in ("plant", "actuator", "recorder")}
+
+    assert [*_finishing(nodes(0))] == ["plant", "actuator", "recorder"]
+    assert [*_finishing(nodes(LOST_PEER_EXIT))] == ["recorder"]
+    assert _finishing(nodes(NOT_STARTED_EXIT)) == {}
+    assert [*_finishing({"actuator": nodes(None)["actuator"]})] == ["actuator"]
 
 
 @pytest.mark.parametrize("options", [GraphOptions(), GraphOptions(bag=Path("b")),

@@ -175,8 +175,10 @@ def _wait_for_plant(processes: dict[str, subprocess.Popen], say: Callable[[str],
 def _finishing(processes: dict[str, subprocess.Popen]) -> dict[str, subprocess.Popen]:
     """The nodes the plant's end leaves work to finish on their own: every node after a
     complete run; only the recorder (its bag) after a run that lost a node, which would be
-    waited for in vain (a stopped actuator: LINGER_S); none when the run never started."""
-    code = processes["plant"].returncode
+    waited for in vain (a stopped actuator: LINGER_S); none when the run never started.
+    Every node too when the plant has no exit code (a stop came first: it ends the wait)."""
+    plant = processes.get("plant")
+    code = None if plant is None else plant.returncode
     if code == NOT_STARTED_EXIT:
         return {}
     if code == LOST_PEER_EXIT:

@@ -212,7 +212,7 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
         model, accepted = _recalibrate(runs, start, accepted, without)
         ended = {s.finding.cause: s.fit.values for s in scored}
         pending = tried_again(scored, best, weak)
-        weak = {s.finding.cause for s in scored if _short(s)}
+        weak = _weak(scored)
     say("checking the relations the rig measures twice")
     checks, calibrated_checks = consistency.of(model), consistency.of(calibrated)
     problems.extend(unchecked_relations(runs, calibrated_checks))
@@ -277,21 +277,18 @@ def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],
 def tried_again(scored: Sequence[Scored], best: Scored, weak: set[str]) -> list[Candidate]:
     """The candidates of a round tried again on the model with its ``best``: every other
     that fitted better (ΔBIC < 0), but not one short of the evidence (ΔBIC not below the
-    threshold) on two models in a row, this round's and the one before's (``weak``).
-
-    A cause masked by another shows once that one is in (I02's sensor offset: ΔBIC −46
-    beside the delay that masked it, −5622 once the delay was in), so a weak one gets one
-    more try. In the whole plan of bench/detection.py (stop 56) none of the 7 weak ones
-    tried again grew significant, and I02's fade, weak twice, was fitted a third time for
-    2.1 s and refused again."""
+    threshold) in this round and the one before (``weak``). A cause masked by another shows
+    once that one is in (I02's offset: ΔBIC −46 beside the delay, −5622 once it was in), so
+    a weak one gets one more try; in the plan of bench/detection.py (stop 56) none of 7
+    tried again grew significant, and I02's fade, weak twice, was refitted for 2.1 s in vain."""
+    twice = weak & _weak(scored)
     return [CATALOGUE[s.finding.cause] for s in scored
-            if s is not best and (s.finding.delta_bic or 0.0) < 0
-            and not (_short(s) and s.finding.cause in weak)]
+            if s is not best and (s.finding.delta_bic or 0.0) < 0 and s.finding.cause not in twice]
 
 
-def _short(scored: Scored) -> bool:
-    """Whether a scored candidate is short of the evidence: ΔBIC not below the threshold."""
-    return (scored.finding.delta_bic or 0.0) >= BIC_THRESHOLD
+def _weak(scored: Sequence[Scored]) -> set[str]:
+    """The causes short of the evidence: ΔBIC not below the threshold."""
+    return {s.finding.cause for s in scored if (s.finding.delta_bic or 0.0) >= BIC_THRESHOLD}
 
 
 def _round_reason(scored: Scored, best: Scored | None) -> str:

@@ -24,7 +24,7 @@ import pytest
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.cli import main
 from landing_gear_sim.diagnosis.catalogue import CATALOGUE, gear_walk_key_parameters
-from landing_gear_sim.diagnosis.diagnose import Diagnosis, diagnose
+from landing_gear_sim.diagnosis.diagnose import Diagnosis, diagnose, tried_again
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.scoring import split_runs
 from landing_gear_sim.errors import DiagnosisError
@@ -628,8 +628,6 @@ def test_a_cause_short_of_the_evidence_on_two_models_in_a_row_is_not_fitted_a_th
     """I02's third round fitted a fade again (2.1 s) that was short of the evidence beside
     the delay and again beside the delay and the offset; a cause masked by the round's
     best gets its one more try (the offset: ΔBIC −46 beside the delay, then −5622)."""
-    from landing_gear_sim.diagnosis.diagnose import tried_again
-
     best = _scored("actuator_delay", -1667.0)
     first = [best, _scored("pressure_sensor_offset", -46.0), _scored("brake_fade", -5.0),
              _scored("tire_relaxation", 7.0)]

@@ -322,12 +322,17 @@ class PlantNode(GraphNode):
         # nothing published is lost when the plant leaves; but a lost node never acknowledges,
         # and the wait lasted until DDS dropped it (16 s after a run with a stopped actuator)
         deadline = time.monotonic() + self._timeout_s if self._lost else None
-        for publisher in (*self._out.values(), self._end):
-            left = -1.0 if deadline is None else max(deadline - time.monotonic(), 0.0)
-            if not publisher.wait_for_all_acked(Duration(seconds=left)):
-                self.get_logger().warning(
-                    f"leaving with {publisher.topic} not acknowledged by every reader within "
-                    f"{self._timeout_s:g} s (a lost node never acknowledges)")
+        unacknowledged = [publisher.topic for publisher in (*self._out.values(), self._end)
+                          if not publisher.wait_for_all_acked(_until(deadline))]
+        if unacknowledged:
+            self.get_logger().warning(
+                f"leaving with {', '.join(unacknowledged)} not acknowledged by every reader "
+                f"within {self._timeout_s:g} s (a lost node never acknowledges)")
+
+
+def _until(deadline: float | None) -> Duration:
+    """The time left until ``deadline`` (monotonic) as a wait's timeout; None: no limit."""
+    return Duration(seconds=-1.0 if deadline is None else max(deadline - time.monotonic(), 0.0))
 
 
 class _Messages:

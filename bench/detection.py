@@ -63,7 +63,7 @@ from landing_gear_sim.diagnosis.catalogue import gear_walk_key_parameters
 from landing_gear_sim.diagnosis.diagnose import Diagnosis, diagnose
 from landing_gear_sim.diagnosis.families import HIDDEN, REGISTRY, Hidden
 from landing_gear_sim.diagnosis.families.equation_terms import EquationTerms
-from landing_gear_sim.diagnosis.scoring import HELD_OUT_THRESHOLD
+from landing_gear_sim.diagnosis.scoring import HELD_OUT_THRESHOLD, fit_changes
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters, load_parameters
@@ -274,7 +274,7 @@ def scored(result: Diagnosis) -> list[dict[str, object]]:
     points] — how near a rule each came (a sweep's margins had been read through a probe)."""
     rows: list[dict[str, object]] = []
     for f in result.candidates:
-        changes = [f.fit_after[c] - f.fit_before[c] for c in f.fit_after if c in f.fit_before]
+        changes = [*fit_changes(f.fit_before, f.fit_after).values()]
         rows.append({"cause": f.cause, "family": f.family, "round": f.round,
                      "delta_bic": f.delta_bic, "held_out": f.held_out,
                      "accepted": f.accepted, "reason": f.reason,

@@ -329,14 +329,20 @@ def _rejection(delta_bic: float, held: HeldOut, at_bound: bool, beyond: str) -> 
     return ""
 
 
+def fit_changes(before: Mapping[str, float], after: Mapping[str, float]) -> dict[str, float]:
+    """What a candidate changes in each channel's fit [% points]: after − before, over the
+    channels both hold."""
+    return {c: after[c] - before[c] for c in after if c in before}
+
+
 def _worsened(held: HeldOut) -> str:
     """The held-out channel a candidate makes worse by more than it gains on its best and
     more than MAX_LOSS_POINTS, in words ('': none)."""
-    losses = {c: held.before[c] - held.after[c] for c in held.after if c in held.before}
-    channel = max(losses, key=losses.__getitem__, default=None)
-    if channel is None or losses[channel] <= max(held.gain, MAX_LOSS_POINTS):
+    changes = fit_changes(held.before, held.after)
+    channel = min(changes, key=changes.__getitem__, default=None)
+    if channel is None or -changes[channel] <= max(held.gain, MAX_LOSS_POINTS):
         return ""
-    return (f"it makes the held-out runs' {channel} worse by {losses[channel]:.2f} fit-% "
+    return (f"it makes the held-out runs' {channel} worse by {-changes[channel]:.2f} fit-% "
             f"points ({held.before[channel]:.1f} → {held.after[channel]:.1f} %), more than "
             f"it makes any channel better (+{held.gain:.2f})")
 
@@ -368,15 +374,16 @@ def _held_out(candidate: Candidate, runs: Sequence[Run], with_it: CandidateFit,
     before, after = (channel_fits(runs, sim, channels) for sim in (sim_without, sim_with))
     rmse_before, rmse_after = (channel_rmse(runs, sim, [*after])
                                for sim in (sim_without, sim_with))
-    logged = max((after[c] - before[c] for c in after), default=0.0)
+    logged = max(fit_changes(before, after).values(), default=0.0)
     if logged >= MIN_GAIN_POINTS:
         return HeldOut(delta, before, after, logged, None, rmse_before, rmse_after)
     clean_before, clean_after = (channel_fits(runs, sim, channels, DENOISED_HZ)
                                  for sim in (sim_without, sim_with))
-    best = max(clean_after, key=lambda c: clean_after[c] - clean_before[c], default=None)
-    if best is None or clean_after[best] - clean_before[best] <= logged:
+    clean = fit_changes(clean_before, clean_after)
+    best = max(clean, key=clean.__getitem__, default=None)
+    if best is None or clean[best] <= logged:
         return HeldOut(delta, before, after, logged, None, rmse_before, rmse_after)
-    return HeldOut(delta, before, after, clean_after[best] - clean_before[best],
+    return HeldOut(delta, before, after, clean[best],
                    (best, clean_before[best], clean_after[best]), rmse_before, rmse_after)
 
 

@@ -25,7 +25,7 @@ from collections import deque
 from pathlib import Path
 
 from landing_gear_sim.errors import GraphError
-from landing_gear_sim.ros.graph import SENSOR_TOPICS
+from landing_gear_sim.ros.graph import RECORDER, SENSOR_TOPICS
 from landing_gear_sim.ros.nodes import stop_requested
 from landing_gear_sim.ros.nodes.common import (
     CONTRACT_KINDS,
@@ -55,7 +55,7 @@ def stamp_ns(raw: bytes) -> int:
 
 class RecorderNode(GraphNode):
     def __init__(self) -> None:
-        super().__init__("recorder")
+        super().__init__(RECORDER)
         lockstep(self)
         path = str(declare(self, "bag", "", "rosbag2 folder to create"))
         storage = str(declare(self, "storage", "mcap", "mcap | sqlite3"))

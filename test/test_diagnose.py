@@ -28,6 +28,7 @@ from landing_gear_sim.diagnosis.diagnose import Diagnosis, diagnose, tried_again
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.scoring import split_runs
 from landing_gear_sim.errors import DiagnosisError
+from landing_gear_sim.model.parameters import load_parameters
 from landing_gear_sim.report.words import headline, parameter_text
 from msg_tools.csv_io import read_csv, write_csv
 from msg_tools.io import read_campaign
@@ -254,6 +255,21 @@ def test_cli_writes_the_contract_json_and_the_report(delay_diagnosed):
     assert headline and abs(float(headline[1]) - 6.0) < 0.3, out
     assert html.escape(headline[0]) in page
     assert main(["params", "--config", str(delay_diagnosed.extended)]) == 0
+
+
+
+def test_the_extended_model_file_opens_with_the_verdict_and_what_it_measured(delay_diagnosed):
+    """`-o` wrote the extended model's values alone: which cause made it, and how sure the
+    diagnosis was, stayed in the terminal. It now opens with the verdict's sentence."""
+    text = delay_diagnosed.extended.read_text(encoding="utf-8")
+    said = " ".join(line.lstrip("# ") for line in text.splitlines() if line.startswith("#"))
+    measured = re.search(r"actuator_delay: the valve answers later than the model's, delay = "
+                         r"(\d\.\d+) ± [\d.]+ ms; on the runs it was not fitted on", said)
+    assert measured and abs(float(measured[1]) - 6.0) < 0.3, said
+    extended = load_parameters([delay_diagnosed.extended])
+    assert extended.values["elements.actuator_delay"] is True
+    assert extended.number("actuator.delay_s") == pytest.approx(float(measured[1]) / 1e3,
+                                                                 abs=5e-6)
 
 
 class _Tables(HTMLParser):

@@ -4,6 +4,7 @@ reason for every candidate's yes or no."""
 from __future__ import annotations
 
 import html
+import re
 
 from landing_gear_sim.diagnosis.relations import Check, Relation
 from landing_gear_sim.report.diagnosis import paired_checks
@@ -195,3 +196,43 @@ def test_a_violation_within_the_inputs_noise_reads_apart_from_structure(tmp_path
     assert _colour(within) != _colour(beyond) == "tab:red"
     _, body = _consistency_section([within, beyond], [within, beyond], tmp_path)
     assert "inputs' noise" in html.unescape(body) and "1.5e+04 Pa" in body
+
+
+def test_the_extended_model_file_writes_its_law_in_engineering_units_and_loads_back(
+        reference, tmp_path, capsys):
+    """U04's extended model (`diagnose -o`) held `wheel.term_1_code: 37.0` and
+    `term_1_coeff: 148.3` and nothing else: its law, J_w·ω̇ = r·F_x − T_b − 148 N m·[P > 0.5
+    bar], was on the terminal only, and `params --config` named the code a code. The file
+    now opens with the verdict and the laws its slots hold, says beside each code what it
+    names, and loads back as the model it was."""
+    from landing_gear_sim.cli import main
+    from landing_gear_sim.diagnosis.diagnose import Diagnosis
+    from landing_gear_sim.diagnosis.findings import Finding
+    from landing_gear_sim.model import basis
+    from landing_gear_sim.model.parameters import load_parameters
+    from landing_gear_sim.report.model_file import write_extended_model
+
+    code = basis.factor_code(basis.PRESSURE, basis.STEP)
+    extended = reference.replace({"wheel.term_1_code": float(code),
+                                  "wheel.term_1_coeff": 148.3}, "pads dragging")
+    found = Finding(cause="discovered", parameters={"[P > 0.5 bar]": 148.3},
+                    std={"[P > 0.5 bar]": 0.3}, evidence="",
+                    fit_before={"wheel_speed_rad_s": 92.5}, fit_after={"wheel_speed_rad_s": 99.5},
+                    delta_bic=-5529.0, held_out=-1517.0, accepted=True, family="wheel",
+                    term="J_w·ω̇ = r·F_x − T_b − 148 N m·[P > 0.5 bar]")
+    result = Diagnosis(verdict="discovered", findings=[found], candidates=[], baseline={},
+                       start=reference, calibrated=reference, extended=extended,
+                       signatures_before=[], signatures_after=[])
+    path = tmp_path / "extended.yaml"
+    write_extended_model(result, path)
+    text = path.read_text(encoding="utf-8")
+    said = " ".join(line.lstrip("# ") for line in text.splitlines() if line.startswith("#"))
+    assert "discovered wheel: the wheel's law lacks a term the runs show" in said, said
+    assert "the wheel: J_w·ω̇ = r·F_x − T_b − 148 N m·[P > 0.5 bar]" in said, said
+    assert "J_w·ω̇" in said.split("lacks a term", 1)[1] and "μ = " not in said  # filled only
+    assert re.search(r"\n +term_1_code: 37\.0 +# \[P > 0\.5 bar\]\n", text), text
+    assert re.search(r"\n +term_1_coeff: 148\.3 +# N m\b", text), text
+    assert load_parameters([path]).values == extended.values
+    assert main(["params", "--config", str(path)]) == 0
+    [row] = [r for r in capsys.readouterr().out.splitlines() if r.startswith("wheel.term_1_code")]
+    assert "[P > 0.5 bar]" in row

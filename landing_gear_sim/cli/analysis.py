@@ -209,6 +209,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
 
     from landing_gear_sim.diagnosis.diagnose import diagnose
     from landing_gear_sim.report.diagnosis import diagnosis_summary, write_diagnosis_report
+    from landing_gear_sim.report.model_file import write_extended_model
     from msg_tools.io import read_runs
 
     campaign = read_runs(args.runs, mapping_of(args))
@@ -228,7 +229,7 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
         page = write_diagnosis_report(result, args.report)
         print(f"report: {page}")
     if args.output:
-        write_atomically(args.output, result.extended.to_yaml)
+        write_atomically(args.output, lambda path: write_extended_model(result, path))
         print(f"extended model: {args.output}")
     print(f"diagnosed {len(campaign.runs)} runs in {time.perf_counter() - started:.1f} s")
     return 0

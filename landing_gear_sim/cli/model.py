@@ -241,14 +241,20 @@ def cmd_bode(args: argparse.Namespace) -> int:
 
 
 def cmd_params(args: argparse.Namespace) -> int:
+    from landing_gear_sim.diagnosis.equation_library import held_notes
+
     params = params_of(args)
+    notes = held_notes(params)  # what a slot's code names: '37.0' alone says nothing
     if args.write:
-        params.to_yaml(args.write)
+        params.to_yaml(args.write, notes=notes)
         print(f"wrote {args.write}")
         return 0
     print(f"# from: {', '.join(params.sources)}")
     for spec in SPECS:
-        print(f"{spec.key:40s} {params[spec.key]!s:>14}  [{spec.unit}]  {spec.description}")
+        note = f"= {notes[spec.key]}: " if spec.key in notes and spec.key.endswith("_code") \
+            else ""
+        print(f"{spec.key:40s} {params[spec.key]!s:>14}  [{spec.unit}]  {note}"
+              f"{spec.description}")
     return 0
 
 

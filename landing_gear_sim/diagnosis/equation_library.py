@@ -378,3 +378,15 @@ LIBRARIES: tuple[Library[Any], ...] = (VALVE, VALVE_DYNAMICS, WHEEL, TYRE, FLYWH
 def equation_checks(campaign: Campaign, params: RigParameters) -> list[Check]:
     """Each library's relation over ``campaign`` under ``params``."""
     return [c for lib in LIBRARIES if (c := lib.check(campaign, params)) is not None]
+
+
+def held_laws(params: RigParameters) -> list[str]:
+    """Each equation whose generic slot ``params`` fills, with its law written out ('the
+    wheel: J_w·ω̇ = r·F_x − T_b − 148 N m·[P > 0.5 bar]')."""
+    return [f"the {library.equation}: {law}" for library in LIBRARIES
+            if (law := library.held_law(params)) is not None]
+
+
+def held_notes(params: RigParameters) -> dict[str, str]:
+    """By key, what each filled place of every generic slot of ``params`` holds."""
+    return {key: note for library in LIBRARIES for key, note in library.held_notes(params).items()}

@@ -17,7 +17,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from landing_gear_sim.model import basis
-from msg_tools.units import display
+from msg_tools.units import display, signed
 
 
 @dataclass(frozen=True)
@@ -96,6 +96,13 @@ def coefficient_unit(equation_unit: str, term: BasisTerm) -> str:
         return f"1/{rest}" if " " not in rest else f"1/({rest})"
     per = f"({term.unit})" if " " in term.unit or "/" in term.unit else term.unit
     return f"{equation_unit}/{per}" if equation_unit != "-" else f"1/{per}"
+
+
+
+def written_term(value: float, term: BasisTerm, equation_unit: str) -> str:
+    """One term of a law: '− 150 N m·[braked before]'."""
+    unit = coefficient_unit(equation_unit, term)
+    return f"{signed(value, '' if unit == '-' else unit)}·{term.name}"
 
 
 class TermLibrary(abc.ABC):

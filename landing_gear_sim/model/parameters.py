@@ -20,6 +20,7 @@ import yaml
 from landing_gear_sim.errors import ParameterError
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.bundled import default_config_files
+from landing_gear_sim.model.params_file import flatten, params_text
 
 if TYPE_CHECKING:
     import numpy as np
@@ -279,8 +280,10 @@ class RigParameters:
                 out[INDEX[spec.key]] = float(value)
         return out
 
-    def to_yaml(self, path: Path, node: str = "/**") -> None:
-        """Write the set as a ROS 2 params file loadable by :func:`load_parameters`."""
+    def to_yaml(self, path: Path, node: str = "/**", header: Sequence[str] = (),
+                notes: Mapping[str, str] | None = None) -> None:
+        """Write the set as a ROS 2 params file loadable by :func:`load_parameters`, with
+        ``header`` and ``notes`` (by key) as comments (:func:`~.params_file.params_text`)."""
         nested: dict[str, Any] = {}
         for spec in SPECS:
             section = nested
@@ -289,8 +292,7 @@ class RigParameters:
                 section = section.setdefault(part, {})
             value = self.values[spec.key]
             section[leaf] = float(value) if spec.kind == "float" else value
-        text = yaml.safe_dump({node: {"ros__parameters": nested}}, sort_keys=False)
-        Path(path).write_text(text)
+        Path(path).write_text(params_text(nested, node, header, notes), encoding="utf-8")
 
 
 def load_parameters(
@@ -342,7 +344,7 @@ def read_params_file(path: Path) -> dict[str, Value]:
     an error (a typo would otherwise silently keep the default).
     """
     try:
-        document = yaml.safe_load(Path(path).read_text())
+        document = yaml.safe_load(Path(path).read_text(encoding="utf-8"))
     except OSError as exc:
         raise ParameterError(f"{path}: cannot read params file ({exc.strerror})") from None
     except yaml.YAMLError as exc:
@@ -353,7 +355,7 @@ def read_params_file(path: Path) -> dict[str, Value]:
     for node, body in document.items():
         if not isinstance(body, dict) or "ros__parameters" not in body:
             raise ParameterError(f"{path}: section {node!r} has no 'ros__parameters'")
-        flat.update(_flatten(body["ros__parameters"] or {}))
+        flat.update(flatten(body["ros__parameters"] or {}))
     owned = {k: v for k, v in flat.items() if k.split(".")[0] in _OWNED_SECTIONS}
     _check_known(owned, str(path))
     return owned
@@ -367,17 +369,6 @@ def _as_ros_reads_it(key: str, value: Value) -> Value:
         except ValueError:
             return value
     return value
-
-
-def _flatten(tree: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
-    flat: dict[str, Any] = {}
-    for key, value in tree.items():
-        name = f"{prefix}{key}"
-        if isinstance(value, dict):
-            flat.update(_flatten(value, name + "."))
-        else:
-            flat[name] = value
-    return flat
 
 
 def _one_line(exc: Exception) -> str:

@@ -38,7 +38,6 @@ from landing_gear_sim.diagnosis.families.base import (
 from landing_gear_sim.diagnosis.flywheel_reads import flywheel_reads
 from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.diagnosis.selection import Selected
-from landing_gear_sim.diagnosis.terms import BasisTerm, coefficient_unit, term_of
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
@@ -108,15 +107,12 @@ class EquationTerms(Family):
         return coeff, params.replace({code: float(term.code), coeff: value}, name)
 
     def formula(self, candidate: Candidate, params: RigParameters) -> str:
-        sign = self.library.sign
-        slot = self.library.slot
-        if slot is None:
+        if self.library.slot is None:
+            sign = self.library.sign
             written = " ".join(f"{signed(sign * params.number(t.key), t.unit)}{t.symbol}"
                                for t in self.library.terms if t.key in candidate.keys)
         else:
-            written = " ".join(_written(sign * params.number(coeff), term_of(
-                round(params.number(code))), self.library.unit)
-                for code, coeff in slot.keys if params.number(coeff) != 0.0)
+            written = self.library.written(params)
         return self.library.law(written, params)
 
 
@@ -142,12 +138,6 @@ def _bound(selected: Selected) -> float:
     if np.isfinite(selected.term.bound):
         return selected.term.bound
     return BOUND_FACTOR * abs(selected.value)
-
-
-def _written(value: float, term: BasisTerm, equation_unit: str) -> str:
-    """One term of a law: '− 150 N m·[braked before]'."""
-    unit = coefficient_unit(equation_unit, term)
-    return f"{signed(value, '' if unit == '-' else unit)}·{term.name}"
 
 
 def _hidden(name: str, library: eq.Library[Any], key: str, span: tuple[float, float],

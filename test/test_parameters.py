@@ -107,6 +107,17 @@ def test_malformed_file_is_a_one_line_error(tmp_path, text, fragment):
     assert "\n" not in str(error.value)
 
 
+def test_a_file_in_another_encoding_is_a_one_line_error(tmp_path):
+    """A params file is read as UTF-8 (YAML's own, and the extended model's laws are
+    written in it); a datasheet saved in Latin-1 had raised a UnicodeDecodeError."""
+    path = tmp_path / "datasheet.yaml"
+    path.write_bytes("# Fr\u00e9quence du servo-valve\n/**:\n  ros__parameters: {}\n"
+                     .encode("latin-1"))
+    with pytest.raises(ParameterError, match=r"datasheet\.yaml: not UTF-8 text") as error:
+        load_parameters([path])
+    assert "\n" not in str(error.value)
+
+
 def test_missing_file_is_named(tmp_path):
     with pytest.raises(ParameterError, match=r"nowhere\.yaml: cannot read"):
         load_parameters([tmp_path / "nowhere.yaml"])

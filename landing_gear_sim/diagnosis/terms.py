@@ -98,7 +98,6 @@ def coefficient_unit(equation_unit: str, term: BasisTerm) -> str:
     return f"{equation_unit}/{per}" if equation_unit != "-" else f"1/{per}"
 
 
-
 def written_term(value: float, term: BasisTerm, equation_unit: str) -> str:
     """One term of a law: '− 150 N m·[braked before]'."""
     unit = coefficient_unit(equation_unit, term)

@@ -347,6 +347,9 @@ def read_params_file(path: Path) -> dict[str, Value]:
         document = yaml.safe_load(Path(path).read_text(encoding="utf-8"))
     except OSError as exc:
         raise ParameterError(f"{path}: cannot read params file ({exc.strerror})") from None
+    except UnicodeDecodeError as exc:
+        raise ParameterError(f"{path}: not UTF-8 text (byte {exc.start}): save it as UTF-8, "
+                             "as YAML asks") from None
     except yaml.YAMLError as exc:
         raise ParameterError(f"{path}: not valid YAML ({_one_line(exc)})") from None
     if not isinstance(document, dict):

@@ -138,11 +138,12 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
 def _write_params(result: Identification, path: Path) -> None:
     """The params file; a partial one starts with the steps whose values were kept."""
-    result.params.to_yaml(path)
-    if result.not_identified:
-        marks = "".join(f"#   {step}\n" for step in result.not_identified)
-        path.write_text("# PARTIAL identification (--partial): these steps did not run, their "
-                        f"parameters keep the base values:\n{marks}" + path.read_text())
+    from landing_gear_sim.diagnosis.equation_library import held_notes
+
+    header = ["PARTIAL identification (--partial): these steps did not run, their parameters "
+              "keep the base values:", *(f"  {step}" for step in result.not_identified)]
+    result.params.to_yaml(path, header=header if result.not_identified else (),
+                          notes=held_notes(result.params))
 
 
 def cmd_validate(args: argparse.Namespace) -> int:

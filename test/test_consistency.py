@@ -5,13 +5,17 @@ generated logs; the code under test never sees them."""
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
 
+from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.calibration.identify import identify
+from landing_gear_sim.calibration.logger import Logger
 from landing_gear_sim.calibration.runs import classify_all
+from landing_gear_sim.calibration.slots import Slot
 from landing_gear_sim.diagnosis.catalogue import CATALOGUE
 from landing_gear_sim.diagnosis.consistency import (
     FREE_ROLLING,
@@ -26,7 +30,11 @@ from landing_gear_sim.diagnosis.consistency import (
 from landing_gear_sim.diagnosis.diagnose import diagnose
 from landing_gear_sim.diagnosis.families import HIDDEN
 from landing_gear_sim.diagnosis.local import local_gains
+from landing_gear_sim.diagnosis.locked_wheel import locked_sliding
 from landing_gear_sim.diagnosis.relations import violations
+from landing_gear_sim.model import basis
+from landing_gear_sim.model import elements as el
+from landing_gear_sim.model import keys as K
 from msg_tools.io import read_campaign
 
 RUNS = ("actuator_ramp", "actuator_steps_sweep", "brake_const_30bar", "brake_const_40bar",
@@ -332,3 +340,40 @@ def test_a_deviation_beyond_its_sigma_but_under_its_floor_is_said_not_ruled_out(
     (said,) = under_floor([tyre, quiet])
     assert "tyre follows its friction curve" in said and "11σ" in said and "0.0455" in said
     assert under_floor([dataclasses.replace(tyre, deviation=0.05)]) == []  # violated: a finding
+
+
+def _locked_sliding(truth, model, folder, logger):
+    """The locked wheel's check of a campaign ``truth`` makes, as ``logger`` writes it,
+    under ``model``."""
+    generate_campaign(folder, truth, 1561, logger=logger)
+    runs = classify_all(read_campaign(folder).runs)
+    return locked_sliding([br.prepare(r, model) for r in runs if r.braking], model)
+
+
+@pytest.mark.parametrize("logger", [Logger(encoder_counts=64, dropout_s=0.05),
+                                    Logger(rate_hz=200.0)], ids=["64 counts", "200 Hz"])
+def test_a_locked_wheel_shows_a_grip_changing_with_speed_the_slip_samples_hide(
+        reference, tmp_path, logger):
+    """Issue 41, never `none`: a friction peak sharpening with speed (μ_B²·v) through a
+    64-count encoder, and μ_B·v² logged at 200 Hz, came out `none` (the plan's 1561 and
+    1544): the samples the curve is fitted on read them under what their slip's noise makes
+    of μ. A locked wheel's slip is 1 exactly, and F_x/F_z is the load cell's. The test
+    draws a rig that locks and a law of grip in speed, unseen by the check; a null of the
+    same rig reads flat."""
+    rng = np.random.default_rng(1561)
+    rig = rig_like(reference, rng)
+    rig = rig.replace({K.FRICTION_THETA1: 0.8 * rig.number(K.FRICTION_THETA1)}, "slippery")
+    coeff = float(rng.uniform(-0.012, -0.006))
+    law = basis.product_code(basis.factor_code(basis.CURVE, basis.SQUARE),
+                             basis.factor_code(basis.SPEED, basis.IDENTITY))
+    (code_key, coeff_key), *_ = Slot.TYRE.keys
+    gripless = rig.replace({code_key: float(law), coeff_key: coeff}, "grip falling with speed")
+    null = _locked_sliding(rig, rig, tmp_path / "null", logger)
+    assert null is not None and not null.violated and abs(null.deviation) < 0.002, null
+    check = _locked_sliding(gripless, rig, tmp_path / "law", logger)
+    assert check is not None and check.violated, check
+    # the law's change of μ(λ = 1) over the speeds slid at, relative to the rig's own μ(1)
+    low, high = (float(v) for v in re.findall(r"\d+\.?\d*", check.phase.split(",")[1])[:2])
+    curve = el.burckhardt_mu(*(rig.number(k) for k in (K.FRICTION_THETA1, K.FRICTION_THETA2,
+                                                       K.FRICTION_THETA3)), 1.0)
+    assert check.deviation == pytest.approx(coeff * curve * (high - low), rel=0.15)

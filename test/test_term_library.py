@@ -19,6 +19,7 @@ from landing_gear_sim.calibration.slots import SEES, Slot
 from landing_gear_sim.diagnosis import equation_library as eq
 from landing_gear_sim.diagnosis.diagnose import diagnose
 from landing_gear_sim.diagnosis.library import Campaign
+from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.diagnosis.start import starting_model
 from landing_gear_sim.diagnosis.terms import (
     Shaped,
@@ -543,3 +544,7 @@ def test_a_cause_that_makes_a_compared_channel_worse_held_out_is_not_named(refer
     assert result.verdict not in CATALOGUE, result.verdict
     relaxation = next(f for f in result.candidates if f.cause == "tire_relaxation")
     assert "wheel_speed_rad_s worse" in relaxation.reason, relaxation.reason
+    # nor `none` (its verdict from stop 55 to 56): its locks slide with less grip the faster
+    assert result.verdict == "unexplained" and result.findings[0].equation == "tyre", \
+        result.verdict
+    assert str(Relation.LOCKED_SLIDING) in result.findings[0].evidence

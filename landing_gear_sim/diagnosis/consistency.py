@@ -53,6 +53,7 @@ from landing_gear_sim.diagnosis.load_relation import (
     LOAD_SPREAD,
     friction_in_load,
 )
+from landing_gear_sim.diagnosis.locked_wheel import locked_sliding
 from landing_gear_sim.diagnosis.relations import (
     MIN_CHECK_S,
     MIN_SAMPLES,
@@ -105,6 +106,8 @@ def check_campaign(runs: Sequence[ClassifiedRun], params: RigParameters) -> list
         checks.extend(_gain_trends(braking, params))
         checks.extend(_pressure_timing(braking, params))
         checks.extend(friction_in_load(braking, params))
+        if (sliding := locked_sliding(braking, params)) is not None:
+            checks.append(sliding)
     checks.extend(equation_checks(Campaign(runs, braking), params))
     return checks
 

@@ -67,7 +67,7 @@ DECLARED: dict[Equation, Declared] = {
         Relation.GAIN_IN_SPEED, Relation.GAIN_IN_PRESSURE, Relation.RUN_DRIFT,
         Relation.FRICTION_IN_LOAD, Relation.BRAKE_ANGLE, Relation.WHEEL_BALANCE)),
     Equation.TYRE: Declared("F_x = F_z·μ(λ) (tyre force)", "wheel_speed_rad_s",
-                            (Relation.TYRE_LAW,)),
+                            (Relation.TYRE_LAW, Relation.LOCKED_SLIDING)),
     Equation.FLYWHEEL: Declared("m_f·v̇ = −F_x − F_drag (flywheel)", "flywheel_speed_rad_s",
                                 (Relation.FLYWHEEL_BALANCE,)),
     Equation.LOADING: Declared("F_z follows F_z0 − k_L·v² (loading device)", "vertical_load_n",

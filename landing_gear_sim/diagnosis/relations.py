@@ -35,6 +35,7 @@ class Relation(str, enum.Enum):
     LOADING_LAW = "vertical load follows F_z0 − k_L v²"
     VALVE_MAP = "valve settles on its quadratic static map"
     TYRE_LAW = "tyre follows its friction curve"
+    LOCKED_SLIDING = "a locked wheel slides at the curve's μ(λ = 1) at every speed"
     FX_CHANNEL = "F_x channel reads F_x where it is known"
     VALVE_DYNAMICS = "valve follows A(s) between its levels"
     PRESSURE_READING = "brake torque follows the pressure read, whenever read"

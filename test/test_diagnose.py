@@ -585,7 +585,8 @@ def test_a_wheel_channel_out_of_step_is_discovered_as_one(reference, tmp_path):
 def test_the_consistency_chart_shows_each_relation_once_and_fits_a_screen(tmp_path):
     """Eleven relations checked on eight runs drew one bar pair per check: ~1,000 px that
     pushed the findings off the first screens. One row per relation (its worst run); the
-    nineteen of now (the tyre's, the F_x and pressure channels') fit 600 px."""
+    twenty of now (the tyre's and its locked wheel's, the F_x and pressure channels') fit
+    600 px."""
     import matplotlib.image
 
     from landing_gear_sim.diagnosis.relations import Check, Relation

@@ -246,7 +246,7 @@ def plot_consistency(rows: Sequence[tuple[Pair, int]], path: Path) -> Path:
     a relation 13σ out but under its physical floor had read as violated beside a verdict
     that said none was.)"""
     pairs = [pair for pair, _ in rows]
-    fig, ax = plt.subplots(figsize=(9, 0.21 * len(pairs) + 1.3))  # 19 relations in 600 px
+    fig, ax = plt.subplots(figsize=(9, 0.2 * len(pairs) + 1.3))  # 20 relations in 600 px
     rows_at = np.arange(len(pairs))
     for offset, alpha, index in ((-0.2, 0.4, 0), (0.2, 1.0, 1)):
         checks = [pair[index] for pair in pairs]

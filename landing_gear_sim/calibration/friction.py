@@ -85,6 +85,13 @@ def tyre_signals(b: Braking, p: RigParameters, idx: np.ndarray) -> np.ndarray:
     return measured
 
 
+def tyre_carries(b: Braking, p: RigParameters) -> np.ndarray:
+    """Samples of ``b`` (mask) where the tyre carries the brake's force: braked 0.3 s,
+    loaded, above the stop speed (the friction curve's samples, and a locked wheel's)."""
+    stop = p.number(K.RIG_TEST_STOP_SPEED_M_S)
+    return (b.time_s > b.start_s + 0.3) & (b.speed_m_s > stop + 2.0) & (b.load > LOADED_N)
+
+
 def friction_indices(b: Braking, p: RigParameters) -> np.ndarray:
     """Samples of ``b`` (indices) that carry the friction curve: braking, loaded, the wheel
     turning and not read well faster than its hub, above the stop speed; at 100 Hz.
@@ -94,9 +101,7 @@ def friction_indices(b: Braking, p: RigParameters) -> np.ndarray:
     λ = −0.13 the curve μ_B(λ) is −32, and such samples (0.5 % of an oscillating run's)
     bent the direct fit to ϑ = 1.86, 10.9, 2.33 for the rig's 0.97, 27.6, 0.15, beyond what
     the refinement may move."""
-    stop = p.number(K.RIG_TEST_STOP_SPEED_M_S)
-    m = (b.time_s > b.start_s + 0.3) & (b.speed_m_s > stop + 2.0) & (b.load > LOADED_N) \
-        & (b.wheel > 1.0)
+    m = tyre_carries(b, p) & (b.wheel > 1.0)
     m &= slip_ratio(hub_speed(b, p), b.wheel, rolling_radius_at(p, b.load)) > LAGGING_SLIP
     return np.flatnonzero(m)[::10]
 

@@ -141,9 +141,9 @@ def _write_params(result: Identification, path: Path) -> None:
     from landing_gear_sim.diagnosis.equation_library import held_notes
 
     header = ["PARTIAL identification (--partial): these steps did not run, their parameters "
-              "keep the base values:", *(f"  {step}" for step in result.not_identified)]
-    result.params.to_yaml(path, header=header if result.not_identified else (),
-                          notes=held_notes(result.params))
+              "keep the base values:", *(f"  {step}" for step in result.not_identified)
+              ] if result.not_identified else []
+    result.params.to_yaml(path, header=header, notes=held_notes(result.params))
 
 
 def cmd_validate(args: argparse.Namespace) -> int:

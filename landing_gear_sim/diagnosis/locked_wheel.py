@@ -19,10 +19,10 @@ import numpy as np
 from scipy.ndimage import maximum_filter1d
 
 from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration.friction import tyre_carries
 from landing_gear_sim.calibration.statistics import linear_std
 from landing_gear_sim.diagnosis.relations import Check, Relation
 from landing_gear_sim.model import elements as el
-from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 
 LOCKED_RAD_S = 0.5  # the wheel is locked below this (filtered, and raw all around)
@@ -71,10 +71,7 @@ def locked_samples(b: br.Braking, params: RigParameters) -> np.ndarray:
     candidate = np.abs(b.wheel) < LOCKED_RAD_S
     noise = 1.4826 * float(np.median(raw[candidate])) if candidate.any() else 0.0
     around = maximum_filter1d(raw, size=max(3, int(AROUND_S * b.run.rate_hz)))
-    stop = params.number(K.RIG_TEST_STOP_SPEED_M_S)
-    locked = candidate & (around < max(LOCKED_RAD_S, NOISE_Z * noise)) \
-        & (b.time_s > b.start_s + SETTLED_S) & (b.load > br.LOADED_N) \
-        & (b.speed_m_s > stop + 2.0)
+    locked = candidate & (around < max(LOCKED_RAD_S, NOISE_Z * noise)) & tyre_carries(b, params)
     index = np.flatnonzero(locked)
     if index.size == 0:
         return index

@@ -188,7 +188,6 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     accepted: list[Scored] = []
     table: list[Finding] = []
     ended: dict[str, dict[str, float]] = {}  # where each candidate's fit ended, by cause
-    weak: set[str] = set()  # the causes short of the evidence in the round before
     for round_ in range(1, MAX_ROUNDS + 1):
         if not pending:
             break
@@ -211,8 +210,7 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
         say(f"re-calibrating with {', '.join(s.finding.cause for s in accepted)}")
         model, accepted = _recalibrate(runs, start, accepted, without)
         ended = {s.finding.cause: s.fit.values for s in scored}
-        pending = tried_again(scored, best, weak)
-        weak = _weak(scored)
+        pending = tried_again(scored, best)
     say("checking the relations the rig measures twice")
     checks, calibrated_checks = consistency.of(model), consistency.of(calibrated)
     problems.extend(unchecked_relations(runs, calibrated_checks))
@@ -274,21 +272,15 @@ def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],
     return testable, [c for c in skipped if _could_show(CATALOGUE[c], runs)]
 
 
-def tried_again(scored: Sequence[Scored], best: Scored, weak: set[str]) -> list[Candidate]:
+def tried_again(scored: Sequence[Scored], best: Scored) -> list[Candidate]:
     """The candidates of a round tried again on the model with its ``best``: every other
-    that fitted better (ΔBIC < 0), but not one short of the evidence (ΔBIC not below the
-    threshold) in this round and the one before (``weak``). A cause masked by another shows
-    once that one is in (I02's offset: ΔBIC −46 beside the delay, −5622 once it was in), so
-    a weak one gets one more try; in the plan of bench/detection.py (stop 56) none of 7
-    tried again grew significant, and I02's fade, weak twice, was refitted for 2.1 s in vain."""
-    twice = weak & _weak(scored)
+    that met the evidence (ΔBIC below the threshold). A cause masked by another shows once
+    that one is in (I02's offset: ΔBIC −46 beside the delay, −5622 once it was in); one short
+    of the evidence is not tried again: in the plans of bench/detection.py (stops 56, 57)
+    none of the six so tried grew significant, and I01's relaxation (ΔBIC −2, then +12)
+    cost 3.8 s of its 15."""
     return [CATALOGUE[s.finding.cause] for s in scored
-            if s is not best and (s.finding.delta_bic or 0.0) < 0 and s.finding.cause not in twice]
-
-
-def _weak(scored: Sequence[Scored]) -> set[str]:
-    """The causes short of the evidence: ΔBIC not below the threshold."""
-    return {s.finding.cause for s in scored if (s.finding.delta_bic or 0.0) >= BIC_THRESHOLD}
+            if s is not best and (s.finding.delta_bic or 0.0) < BIC_THRESHOLD]
 
 
 def _round_reason(scored: Scored, best: Scored | None) -> str:

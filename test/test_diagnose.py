@@ -24,8 +24,10 @@ import pytest
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.cli import main
 from landing_gear_sim.diagnosis.catalogue import CATALOGUE, gear_walk_key_parameters
+from landing_gear_sim.diagnosis.consistency import inconsistent
 from landing_gear_sim.diagnosis.diagnose import Diagnosis, diagnose, tried_again
 from landing_gear_sim.diagnosis.findings import Finding
+from landing_gear_sim.diagnosis.relations import Check, Relation
 from landing_gear_sim.diagnosis.scoring import split_runs
 from landing_gear_sim.errors import DiagnosisError
 from landing_gear_sim.model.parameters import load_parameters
@@ -435,6 +437,28 @@ def test_a_discovered_term_is_said_as_its_equations_law(reference):
     assert measured.to_json()["rmse_after"] == {"wheel_speed_rad_s": 0.98}
 
 
+def test_a_violated_relation_left_unexplained_reads_in_its_relations_unit(reference):
+    """The verdict had said 'deviation = 17.75 ± 2' for a flywheel's drag in N s and a
+    pressure's in Pa alike: the relation's unit was in the evidence only."""
+    def broken(relation: Relation, deviation: float, std: float, unit: str) -> Check:
+        return Check(relation, "campaign", "braking runs", deviation, std, 0.0, unit)
+
+    def said(check: Check) -> str:
+        result = Diagnosis(verdict="unexplained", findings=[inconsistent([check])],
+                           candidates=[], baseline={}, start=reference, calibrated=reference,
+                           extended=reference, signatures_before=[], signatures_after=[])
+        return headline(result)
+
+    assert "deviation = 1.23 ± 0.05 bar" in said(
+        broken(Relation.VALVE_DIRECTION, 1.23e5, 5e3, "Pa"))
+    assert "deviation = 17.75 ± 2 N s" in said(
+        broken(Relation.FLYWHEEL_BALANCE, 17.75, 2.0, "N s"))
+    assert said(broken(Relation.TYRE_LAW, 0.1014, 0.0062, "-")).endswith(
+        "deviation = 0.1014 ± 0.0062.")  # a ratio: no unit
+    assert inconsistent([broken(Relation.FLYWHEEL_BALANCE, 17.75, 2.0, "N s")]).to_json()[
+        "units"] == {"deviation": "N s"}
+
+
 def test_cli_diagnose_on_a_missing_folder_is_one_error_line(capsys):
     assert main(["diagnose", "/nonexistent/campaign"]) == 2
     assert capsys.readouterr().err.count("\n") == 1
@@ -589,7 +613,6 @@ def test_the_consistency_chart_shows_each_relation_once_and_fits_a_screen(tmp_pa
     600 px."""
     import matplotlib.image
 
-    from landing_gear_sim.diagnosis.relations import Check, Relation
     from landing_gear_sim.report.diagnosis import plot_consistency, worst_per_relation
 
     def check(relation, run, z):

@@ -164,7 +164,7 @@ def inconsistent(broken: Sequence[Check]) -> Finding:
     equation = declaring(best.relation)
     channel = DECLARED[equation].channel
     return Finding(cause="unexplained", parameters={"deviation": best.deviation},
-                   std={"deviation": best.std},
+                   std={"deviation": best.std}, units={"deviation": best.unit},
                    evidence=f"measured relations the model cannot break are violated, in the "
                    f"{equation}: " + "; ".join(c.describe() for c in broken[:4])
                    + (f"; and {len(broken) - 4} more" if len(broken) > 4 else ""),

@@ -61,6 +61,9 @@ class Finding:
     rmse_before: dict[str, float] = field(default_factory=dict)
     rmse_after: dict[str, float] = field(default_factory=dict)
     """RMSE per channel on the held-out runs [the channel's SI unit], beside the fit %."""
+    units: dict[str, str] = field(default_factory=dict)
+    """The SI unit of a parameter whose key does not carry one (an ``unexplained``
+    finding's deviation, in its relation's unit; '-': a ratio)."""
 
     def to_json(self) -> dict[str, object]:
         document: dict[str, object] = {"cause": self.cause, "parameters": self.parameters,
@@ -76,6 +79,8 @@ class Finding:
             document |= {"family": self.family, "term": self.term}
         if self.equation:
             document |= {"equation": self.equation, "channel": self.channel}
+        if self.units:
+            document |= {"units": self.units}
         return document
 
 

@@ -80,7 +80,7 @@ def _rmse(finding: Finding, channel: str) -> str:
 
 def parameters_text(finding: Finding) -> str:
     """``finding``'s parameters, each ``name = value ± σ`` in engineering units."""
-    return ", ".join(parameter_text(k, v, finding.std.get(k))
+    return ", ".join(parameter_text(k, v, finding.std.get(k), finding.units.get(k))
                      for k, v in finding.parameters.items())
 
 
@@ -126,18 +126,24 @@ KEY_UNITS = {"s": "s", "pa": "Pa", "n": "N", "a": "A", "m": "m", "j": "J", "hz":
 ``x_per_n``: per newton)."""
 
 
-def parameter_text(key: str, value: float, std: float | None) -> str:
+def parameter_text(key: str, value: float, std: float | None, unit: str | None = None
+                   ) -> str:
     """``name = value ± σ`` in the unit a brake engineer reads, e.g. 'delay = 5.99 ± 0.29 ms'
     for ``actuator_delay.delay_s`` (issue 32: 0.0059941 ± 0.00029 s), 'gain_drift = −3.475 ±
-    0.0014 %/run' for ``gain_drift_per_run``."""
+    0.0014 %/run' for ``gain_drift_per_run``; ``unit``: the SI unit of a key that carries
+    none ('-': a ratio)."""
     if not re.fullmatch(r"[\w.]+", key):  # a discovered term's name ('[P > 0.5 bar]'): whole
         return f"{key} = {value:.4g}" + ("" if std is None else f" ± {std:.2g}")
-    name, _, suffix = key.rsplit(".", 1)[-1].rpartition("_")
-    unit = KEY_UNITS.get(suffix)
+    leaf = key.rsplit(".", 1)[-1]
+    name, _, suffix = leaf.rpartition("_")
+    if unit is None:
+        unit = KEY_UNITS.get(suffix)
+    else:
+        name, unit = leaf, None if unit == "-" else unit
     if unit is not None and name.endswith("_per"):
         name, unit = name.removesuffix("_per"), f"1/{unit}"
     if unit is None or unit == "1":
-        name = key.rsplit(".", 1)[-1]
+        name = leaf
     if unit is None:
         return f"{name} = {value:.4g}" + ("" if std is None else f" ± {std:.2g}")
     shown = display(value, unit, ".4g")

@@ -16,6 +16,7 @@ from landing_gear_sim.calibration.identify import identify
 from landing_gear_sim.calibration.logger import Logger
 from landing_gear_sim.calibration.runs import classify_all
 from landing_gear_sim.calibration.slots import Slot
+from landing_gear_sim.diagnosis import equation_library as eq
 from landing_gear_sim.diagnosis.catalogue import CATALOGUE
 from landing_gear_sim.diagnosis.consistency import (
     FREE_ROLLING,
@@ -29,6 +30,7 @@ from landing_gear_sim.diagnosis.consistency import (
 )
 from landing_gear_sim.diagnosis.diagnose import diagnose
 from landing_gear_sim.diagnosis.families import HIDDEN
+from landing_gear_sim.diagnosis.library import Campaign
 from landing_gear_sim.diagnosis.local import local_gains
 from landing_gear_sim.diagnosis.locked_wheel import locked_sliding
 from landing_gear_sim.diagnosis.relations import violations
@@ -344,10 +346,12 @@ def test_a_deviation_beyond_its_sigma_but_under_its_floor_is_said_not_ruled_out(
 
 def _locked_sliding(truth, model, folder, logger):
     """The locked wheel's check of a campaign ``truth`` makes, as ``logger`` writes it,
-    under ``model``."""
+    under ``model``, and the tyre's terms read where the wheel locks."""
     generate_campaign(folder, truth, 1561, logger=logger)
     runs = classify_all(read_campaign(folder).runs)
-    return locked_sliding([br.prepare(r, model) for r in runs if r.braking], model)
+    braking = [br.prepare(r, model) for r in runs if r.braking]
+    return (locked_sliding(braking, model),
+            eq.LOCKED_TYRE.select(Campaign(runs, braking), model))
 
 
 @pytest.mark.parametrize("logger", [Logger(encoder_counts=64, dropout_s=0.05),
@@ -359,7 +363,8 @@ def test_a_locked_wheel_shows_a_grip_changing_with_speed_the_slip_samples_hide(
     1544): the samples the curve is fitted on read them under what their slip's noise makes
     of μ. A locked wheel's slip is 1 exactly, and F_x/F_z is the load cell's. The test
     draws a rig that locks and a law of grip in speed, unseen by the check; a null of the
-    same rig reads flat."""
+    same rig reads flat. Then (stop 58: they had stayed `unexplained`) the tyre's terms
+    read where the wheel locks name a grip in speed, and none in the null."""
     rng = np.random.default_rng(1561)
     rig = rig_like(reference, rng)
     rig = rig.replace({K.FRICTION_THETA1: 0.8 * rig.number(K.FRICTION_THETA1)}, "slippery")
@@ -368,10 +373,13 @@ def test_a_locked_wheel_shows_a_grip_changing_with_speed_the_slip_samples_hide(
                              basis.factor_code(basis.SPEED, basis.IDENTITY))
     (code_key, coeff_key), *_ = Slot.TYRE.keys
     gripless = rig.replace({code_key: float(law), coeff_key: coeff}, "grip falling with speed")
-    null = _locked_sliding(rig, rig, tmp_path / "null", logger)
+    null, quiet = _locked_sliding(rig, rig, tmp_path / "null", logger)
     assert null is not None and not null.violated and abs(null.deviation) < 0.002, null
-    check = _locked_sliding(gripless, rig, tmp_path / "law", logger)
+    check, terms = _locked_sliding(gripless, rig, tmp_path / "law", logger)
     assert check is not None and check.violated, check
+    assert quiet == [], [(t.term.name, t.value) for t in quiet]
+    (term,) = terms  # μ_B·v or μ_B·√v: at λ = 1, μ_B²·v is μ_B(1)·(μ_B·v)
+    assert term.term.name in {"μ_B·v", "μ_B·√v"} and term.value < 0, term
     # the law's change of μ(λ = 1) over the speeds slid at, relative to the rig's own μ(1)
     low, high = (float(v) for v in re.findall(r"\d+\.?\d*", check.phase.split(",")[1])[:2])
     curve = el.burckhardt_mu(*(rig.number(k) for k in (K.FRICTION_THETA1, K.FRICTION_THETA2,

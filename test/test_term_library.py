@@ -544,7 +544,14 @@ def test_a_cause_that_makes_a_compared_channel_worse_held_out_is_not_named(refer
     assert result.verdict not in CATALOGUE, result.verdict
     relaxation = next(f for f in result.candidates if f.cause == "tire_relaxation")
     assert "wheel_speed_rad_s worse" in relaxation.reason, relaxation.reason
-    # nor `none` (its verdict from stop 55 to 56): its locks slide with less grip the faster
-    assert result.verdict == "unexplained" and result.findings[0].equation == "tyre", \
-        result.verdict
-    assert str(Relation.LOCKED_SLIDING) in result.findings[0].evidence
+    # nor `none` (stop 55 to 56) nor `unexplained` (stop 57): its locks slide with less grip
+    # the faster, and the tyre's terms read there, where the slip is 1 through any encoder
+    found = _first(result, "tyre")
+    assert str(Relation.LOCKED_SLIDING) in found.evidence.partition(";")[0], found.evidence
+    # the law found takes off the locked wheel's grip between 30 and 55 m/s what the drawn
+    # one does (its form is the library's: μ_B·v or μ_B·√v for μ_B²·v)
+    def sliding_loss(params) -> float:
+        p, load = params.vector(), params.number(K.LOADING_STATIC_LOAD_N)
+        return el.tyre_friction(p, 1.0, 55.0, load) / el.tyre_friction(p, 1.0, 30.0, load)
+
+    assert 1 - sliding_loss(result.extended) == pytest.approx(1 - sliding_loss(rig), rel=0.3)

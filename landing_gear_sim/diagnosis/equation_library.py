@@ -38,6 +38,7 @@ from landing_gear_sim.diagnosis.library import (
     thinned,
     torque_rows,
 )
+from landing_gear_sim.diagnosis.locked_wheel import locked_samples
 from landing_gear_sim.diagnosis.pressure_channel import PRESSURE_CHANNEL
 from landing_gear_sim.diagnosis.relations import Check, Relation
 from landing_gear_sim.diagnosis.selection import Rows, Term, basis_terms, term_columns
@@ -234,6 +235,37 @@ class TyreLibrary(BrakingLibrary):
         return f"μ = μ_B(λ)·g(F_z) {written}"
 
 
+class LockedTyreLibrary(TyreLibrary):
+    """The tyre's law where the wheel is locked (:mod:`~.locked_wheel`): the slip is 1
+    exactly there whatever the wheel channel reads, so a term in speed shows free of the
+    slip's noise that floors the curve's samples (the plan's 1561 and 1544, unexplained in
+    the tyre). Its rows are about each run's mean (its relation reads a trend within the
+    runs, beside each run's level). Not a check of its own: its relation is the locked
+    wheel's; it says which terms a violation of it needs."""
+
+    relation = Relation.LOCKED_SLIDING
+    phase = "locked wheel"
+
+    def rows(self, b: br.Braking, params: RigParameters,
+             terms: Sequence[Term[br.Braking]] | None = None) -> Rows | None:
+        index = locked_samples(b, params)
+        if index.size < 20:
+            return None
+        _, curve_mu = friction.samples_at(b, params, index)
+        factor = load_factor_at(params, b.load[index])
+        t1, t2, t3 = friction_coefficients(params)
+        model = el.burckhardt_mu(t1, t2, t3, 1.0)
+        signals = friction.tyre_signals(b, params, index)
+        signals[:, basis.SLIP], signals[:, basis.CURVE] = 1.0, model
+        owned = np.column_stack([np.full(index.size, 1.0 - np.exp(-t2)),
+                                 np.full(index.size, t1 * np.exp(-t2)),
+                                 np.full(index.size, -1.0)]) * factor[:, None]
+        return about_run_mean((curve_mu - model) * factor,
+                              term_columns(terms or self.terms, b, params, index,
+                                           seen(Slot.TYRE, signals)),
+                              owned, abs(model) * float(np.mean(factor)))
+
+
 FX_TERMS = (Shaped((basis.RUN_TIME,), (basis.IDENTITY, basis.SQUARE, basis.SIGNED_ROOT))
             + Shaped((basis.LOAD,), (basis.SIGNED_SQUARE,))
             + Shaped((basis.RUN_TIME,), (basis.IDENTITY,)) * Shaped((basis.LOAD,),
@@ -368,6 +400,7 @@ def channel_noise(values: np.ndarray) -> float:
 
 WHEEL = WheelLibrary()
 TYRE = TyreLibrary()
+LOCKED_TYRE = LockedTyreLibrary()  # the tyre's slot read where the wheel locks; not a check
 FLYWHEEL = FlywheelLibrary()
 LOADING = LoadingLibrary()
 FX_CHANNEL = FxChannelLibrary()

@@ -183,8 +183,14 @@ class LoadingTerms(EquationTerms):
 
 
 class TyreTerms(EquationTerms):
+    """The tyre's slot, read on the friction curve's samples, or, when only the locked
+    wheel's relation is violated, where the wheel locks (:class:`~..LockedTyreLibrary`):
+    a grip changing with speed that the curve's slip noise hides there (the plan's 1561,
+    μ_B²·v through a 64-count encoder, had been left unexplained)."""
+
     name = "tyre_equation"
     library = eq.TYRE
+    also_breaks = (Relation.LOCKED_SLIDING,)
     free = FRICTION
     channels = WHEEL
     # a friction that falls with the sliding speed (the seed paper's ref. [8]), drawn in
@@ -195,6 +201,14 @@ class TyreTerms(EquationTerms):
             basis.factor_code(basis.SPEED, basis.IDENTITY))),
         K.TYRE_TERMS[0][1]: rng.uniform(-0.004, -0.002)}, K.TYRE_TERMS[0][1], "μ_B·v",
         TOLERANCE),)
+
+    def propose(self, evidence: Evidence) -> list[Proposal]:
+        if evidence.violated(self.library.relation) or not evidence.violated(
+                Relation.LOCKED_SLIDING):
+            return super().propose(evidence)
+        chosen = eq.LOCKED_TYRE.select(evidence.campaign, evidence.model)
+        return [p for terms in _alternatives(chosen)
+                if (p := self._proposal(evidence, terms)) is not None]
 
 
 class ValveTerms(EquationTerms):

@@ -222,13 +222,12 @@ class TyreLibrary(BrakingLibrary):
         factor = load_factor_at(params, b.load[index])
         t1, t2, t3 = friction_coefficients(params)
         model = el.burckhardt_mu(t1, t2, t3, slip)
-        decay = np.exp(-t2 * slip)
-        owned = np.column_stack([1.0 - decay, t1 * slip * decay, -slip]) * factor[:, None]
         measured = seen(Slot.TYRE, friction.tyre_signals(b, params, index))
-        slope = t1 * t2 * decay - t3
+        slope = t1 * t2 * np.exp(-t2 * slip) - t3
         return Rows((curve_mu - model) * factor,
                     term_columns(terms or self.terms, b, params, index, measured),
-                    owned, float(np.mean(np.abs(model * factor))),
+                    _curve_derivatives(params, slip, factor),
+                    float(np.mean(np.abs(model * factor))),
                     float(np.sqrt(np.mean((slope * factor * _slip_noise(b, index)) ** 2))))
 
     def law(self, written: str, params: RigParameters) -> str:
@@ -253,17 +252,24 @@ class LockedTyreLibrary(TyreLibrary):
             return None
         _, curve_mu = friction.samples_at(b, params, index)
         factor = load_factor_at(params, b.load[index])
-        t1, t2, t3 = friction_coefficients(params)
-        model = el.burckhardt_mu(t1, t2, t3, 1.0)
+        slip = np.ones(index.size)
+        model = el.burckhardt_mu(*friction_coefficients(params), slip)
         signals = friction.tyre_signals(b, params, index)
-        signals[:, basis.SLIP], signals[:, basis.CURVE] = 1.0, model
-        owned = np.column_stack([np.full(index.size, 1.0 - np.exp(-t2)),
-                                 np.full(index.size, t1 * np.exp(-t2)),
-                                 np.full(index.size, -1.0)]) * factor[:, None]
+        signals[:, basis.SLIP], signals[:, basis.CURVE] = slip, model
         return about_run_mean((curve_mu - model) * factor,
                               term_columns(terms or self.terms, b, params, index,
                                            seen(Slot.TYRE, signals)),
-                              owned, abs(model) * float(np.mean(factor)))
+                              _curve_derivatives(params, slip, factor),
+                              float(np.mean(np.abs(model * factor))))
+
+
+def _curve_derivatives(params: RigParameters, slip: np.ndarray, factor: np.ndarray
+                       ) -> np.ndarray:
+    """The curve μ_B's derivatives in ϑ1, ϑ2, ϑ3 at ``slip``, times the load ``factor``: the
+    terms the calibration owns in the tyre's law (it may bend the curve)."""
+    t1, t2, _ = friction_coefficients(params)
+    decay = np.exp(-t2 * slip)
+    return np.column_stack([1.0 - decay, t1 * slip * decay, -slip]) * factor[:, None]
 
 
 FX_TERMS = (Shaped((basis.RUN_TIME,), (basis.IDENTITY, basis.SQUARE, basis.SIGNED_ROOT))

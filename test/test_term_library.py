@@ -105,6 +105,16 @@ def test_a_term_names_its_unit_and_its_coefficients():
     released = product_term(factor_term(basis.PRESSURE_RATE, basis.SIGN),
                             factor_term(basis.VALVE_ERROR, basis.IDENTITY))
     assert coefficient_unit("Pa", released) == "-"
+    # a root reads as one (1561's tyre law had read '− 0.0571 1/((m/s)^0.5)·μ_B·√v')
+    root = product_term(factor_term(basis.CURVE, basis.IDENTITY),
+                        factor_term(basis.SPEED, basis.SIGNED_ROOT))
+    assert (root.unit, coefficient_unit("-", root)) == ("√(m/s)", "1/√(m/s)")
+    assert coefficient_unit("N m", factor_term(basis.OMEGA, basis.SIGNED_ROOT)) == "N m/√(rad/s)"
+    assert coefficient_unit("Pa", factor_term(basis.PRESSURE, basis.SIGNED_ROOT)) == "√Pa"
+    assert coefficient_unit("N m", factor_term(basis.PRESSURE, basis.SIGNED_ROOT)) == "N m/√Pa"
+    load_root = product_term(factor_term(basis.LOAD, basis.IDENTITY),
+                             factor_term(basis.SPEED, basis.SIGNED_ROOT))
+    assert coefficient_unit("N", load_root) == "1/√(m/s)"  # had read 's)^0.5/(m'
 
 
 def test_each_library_composes_only_the_signals_its_equation_sees_in_the_plant():

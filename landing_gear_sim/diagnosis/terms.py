@@ -49,8 +49,10 @@ def _power(unit: str, power: float) -> str:
         return "-"
     if power == 1:
         return unit
-    shown = f"{power:g}"
-    return f"({unit})^{shown}" if " " in unit or "/" in unit else f"{unit}^{shown}"
+    compound = " " in unit or "/" in unit
+    if power == 0.5:
+        return f"√({unit})" if compound else f"√{unit}"
+    return f"({unit})^{power:g}" if compound else f"{unit}^{power:g}"
 
 
 def factor_term(signal: int, shape: int) -> BasisTerm:
@@ -80,6 +82,8 @@ def coefficient_unit(equation_unit: str, term: BasisTerm) -> str:
     """The unit of a coefficient of ``term`` in an equation of ``equation_unit``."""
     if term.unit == "-":
         return equation_unit
+    if term.unit in (f"√{equation_unit}", f"√({equation_unit})"):  # √P in Pa: √Pa
+        return term.unit
     base, _, power = term.unit.partition("^")
     if base == equation_unit and power:  # |ΔP|·ΔP in an equation in Pa: 1/Pa
         left = 1.0 - float(power)
@@ -90,11 +94,13 @@ def coefficient_unit(equation_unit: str, term: BasisTerm) -> str:
         rest = " ".join(factors)
         if not rest:  # sgn Ṗ·ΔP in an equation in Pa: a plain number
             return "-"
-        if "/" in rest and " " not in rest:
+        if "/" in rest and not any(c in rest for c in " (√"):  # m/s: s/m
             numerator, denominator = rest.split("/")
             return f"{denominator}/{numerator}"
         return f"1/{rest}" if " " not in rest else f"1/({rest})"
-    per = f"({term.unit})" if " " in term.unit or "/" in term.unit else term.unit
+    whole = term.unit.startswith("√") and " " not in term.unit  # a root reads as one
+    per = f"({term.unit})" if not whole and (" " in term.unit or "/" in term.unit) \
+        else term.unit
     return f"{equation_unit}/{per}" if equation_unit != "-" else f"1/{per}"
 
 

@@ -73,6 +73,11 @@ class EquationTerms(Family):
         if not evidence.violated(self.library.relation):
             return []
         chosen = self.library.select(evidence.campaign, evidence.model)
+        return self._proposals(evidence, chosen)
+
+    def _proposals(self, evidence: Evidence, chosen: list[Selected]) -> list[Proposal]:
+        """A proposal of the terms ``chosen``, and one of each alternative the samples could
+        not tell from them (:func:`_alternatives`)."""
         return [p for terms in _alternatives(chosen)
                 if (p := self._proposal(evidence, terms)) is not None]
 
@@ -207,8 +212,7 @@ class TyreTerms(EquationTerms):
                 Relation.LOCKED_SLIDING):
             return super().propose(evidence)
         chosen = eq.LOCKED_TYRE.select(evidence.campaign, evidence.model)
-        return [p for terms in _alternatives(chosen)
-                if (p := self._proposal(evidence, terms)) is not None]
+        return self._proposals(evidence, chosen)
 
 
 class ValveTerms(EquationTerms):
@@ -246,8 +250,7 @@ class FxChannelTerms(EquationTerms):
             return []
         chosen = [s for s in self.library.select(evidence.campaign, evidence.model)
                   if _flywheel_reads(evidence, s)]
-        return [p for terms in _alternatives(chosen)
-                if (p := self._proposal(evidence, terms)) is not None]
+        return self._proposals(evidence, chosen)
 
 
 class PressureChannelTerms(EquationTerms):
@@ -272,8 +275,7 @@ class PressureChannelTerms(EquationTerms):
         if not any(evidence.violated(r) for r in self.relations):
             return []
         chosen = self.library.select(evidence.campaign, evidence.model)  # the valve reads
-        return [p for terms in _alternatives(chosen)
-                if (p := self._proposal(evidence, terms)) is not None]
+        return self._proposals(evidence, chosen)
 
 
 def _flywheel_reads(evidence: Evidence, selected: Selected) -> bool:

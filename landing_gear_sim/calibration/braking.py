@@ -1,6 +1,7 @@
-"""Braking runs (paper Section IV-D): the rolling radius from free rolling, the flywheel's
-inertia and drag from its momentum balance, the brake gain (and fade) from the wheel's
-torque balance r F_x − J_w ω̇ = k_b P. Signals are low-passed (zero phase) first."""
+"""Braking runs (paper Section IV-D): their filtered signals, the rolling radius from free
+rolling, the brake gain (and fade) from the wheel's torque balance r F_x − J_w ω̇ = k_b P
+(the flywheel's balance: :mod:`~landing_gear_sim.calibration.flywheel`). Signals are
+low-passed (zero phase) first."""
 
 from __future__ import annotations
 
@@ -10,7 +11,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 import scipy.signal
 from scipy.optimize import least_squares
 
@@ -20,14 +20,13 @@ from landing_gear_sim.calibration.statistics import (
     Estimate,
     covariance_std,
     linear_std,
-    run_weights,
+    sample_weights,
 )
 from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.elements import (
     brake_torques,
     fade_factor,
-    flywheel_extra_force,
     slip_ratio,
     wheel_extra_torque,
 )
@@ -102,20 +101,14 @@ def run_time_s(run: ClassifiedRun) -> np.ndarray:
 
 def free_rolling_excess(b: Braking, params: RigParameters) -> tuple[np.ndarray, np.ndarray]:
     """The samples before the brake acts (mask), and the F_x there (the model's crosstalk
-    taken off the reading) less the wheel's inertia force J_w ω̇ / r and the force the tyre
-    pushes the model's own wheel torque with (its generic slot: a bearing's) [N]: what the
-    load cell reads beyond the physics."""
+    taken off the reading) less what the wheel's balance asks of the tyre with no brake,
+    (J_w ω̇ + T_extra)/r [N]: what the load cell reads beyond the physics."""
     m = free_rolling(b)
-    radius = rolling_radius_at(params, b.load[m])
-    torque = (params.number(K.WHEEL_INERTIA_KG_M2) * b.wheel_rate[m]
-              + wheel_extra_torque(params.vector(), b.wheel[m]))
-    if Slot.WHEEL.occupied(params):
-        _, energy = torque_balance(b, params)
-        torque = torque + Slot.WHEEL.value_of(params, measured_signals(b, params, energy))[m]
+    resisted, _ = wheel_resisted(b, params)
     force = SensorModel.of(params).true_longitudinal(b.run.longitudinal_force_n[m],
                                                      b.run.vertical_load_n[m],
                                                      run_time_s(b.run)[m])
-    return m, force - torque / radius
+    return m, force - resisted[m] / rolling_radius_at(params, b.load[m])
 
 
 def slip(b: Braking, p: RigParameters) -> np.ndarray:
@@ -160,61 +153,29 @@ def fit_unloaded_radius(runs: Sequence[Braking], p: RigParameters) -> Estimate:
                     tuple(b.run.name for b in runs), "free rolling v/ω, a and b kept")
 
 
-def fit_flywheel(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
-    """J_f and α_d from the integrated balance M Δv = −∫F_x − α ∫v² (robust to noise).
-
-    Each run gets its own intercept: anchoring a run to one noisy speed sample
-    would shift all its rows and bias the drag.
-    """
-    blocks, targets = [], []
-    for b in runs:
-        idx = np.flatnonzero((b.time_s > 0.6) & (b.speed_m_s > 5.0))[::10]
-        if idx.size < 20:
-            continue
-        dt = np.diff(b.time_s, prepend=b.time_s[0])
-        # the flywheel's slots are known, like F_x (0 unless a diagnosis found a term)
-        force = b.force + flywheel_extra(b, p)
-        blocks.append(np.column_stack([-np.cumsum(force * dt)[idx],
-                                       -np.cumsum(b.speed_m_s ** 2 * dt)[idx]]))
-        targets.append(b.speed_m_s[idx])
-    if not blocks:
-        raise IdentificationError("no braking run long enough for the flywheel balance")
-    offsets = scipy.linalg.block_diag(*[np.ones((len(y), 1)) for y in targets])
-    weight = _sample_weights(targets)
-    x = np.hstack([np.vstack(blocks), offsets]) * weight[:, None]
-    y = np.concatenate(targets) * weight
-    coef, *_ = np.linalg.lstsq(x, y, rcond=None)
-    std_inv, std_ratio = linear_std(x, y - x @ coef, x.shape[1])[:2]
-    inv_mass, alpha_over_mass = coef[:2]
-    mass = 1.0 / inv_mass
-    radius = p.number(K.FLYWHEEL_RADIUS_M)
-    names = tuple(b.run.name for b in runs)
-    alpha = alpha_over_mass * mass
-    std_alpha = abs(alpha) * math.hypot(std_ratio / alpha_over_mass, std_inv * mass)
-    return [
-        Estimate(K.FLYWHEEL_INERTIA_KG_M2, mass * radius ** 2,
-                 mass ** 2 * std_inv * radius ** 2, names, "integrated momentum balance"),
-        Estimate(K.DRAG_COEFF_N_S2_PER_M2, float(alpha), float(std_alpha), names,
-                 "integrated momentum balance"),
-    ]
-
-
-def _sample_weights(per_run: Sequence[np.ndarray]) -> np.ndarray:
-    """Each sample's run weight (:func:`run_weights`), shape (total samples,)."""
-    sizes = [values.size for values in per_run]
-    return np.repeat(run_weights(sizes), sizes)
-
-
 def torque_balance(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
-    """Brake torque r F_x − J_w ω̇ − T_extra [N m] (T_extra: the wheel's slots of ``p``, 0
-    unless a diagnosis found a term) and the energy the brake absorbed, ∫ T_b ω dt [J]."""
-    torque = rolling_radius_at(p, b.load) * b.force - p.number(K.WHEEL_INERTIA_KG_M2) \
-        * b.wheel_rate - wheel_extra_torque(p.vector(), b.wheel)
-    energy = _absorbed(b, torque)
-    if Slot.WHEEL.occupied(p):  # a term may read the energy: taken from the torque without it
-        torque = torque - Slot.WHEEL.value_of(p, measured_signals(b, p, energy))
-        energy = _absorbed(b, torque)
-    return torque, energy
+    """The brake torque T_b the wheel's balance J_w ω̇ = r F_x − T_b − T_extra measures at
+    each sample of ``b`` [N m], and the energy the brake absorbed, ∫ T_b ω dt [J]. The one
+    reading of the wheel's balance from measured signals: the calibration's gain, the
+    diagnosis's wheel error and library, the free rolling's F_x and the disc's run-out all
+    read it."""
+    resisted, energy = wheel_resisted(b, p)
+    return rolling_radius_at(p, b.load) * b.force - resisted, energy
+
+
+def wheel_resisted(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
+    """What the wheel's balance takes off r F_x beside the brake, J_w ω̇ + T_extra [N m]
+    (T_extra: the wheel's named slot and its generic slot of ``p``, 0 unless a diagnosis
+    found a term), and the energy the brake absorbed [J] (a term may read it: taken from the
+    torque without the generic slot)."""
+    pushed = rolling_radius_at(p, b.load) * b.force
+    resisted = p.number(K.WHEEL_INERTIA_KG_M2) * b.wheel_rate \
+        + wheel_extra_torque(p.vector(), b.wheel)
+    energy = _absorbed(b, pushed - resisted)
+    if Slot.WHEEL.occupied(p):
+        resisted = resisted + Slot.WHEEL.value_of(p, measured_signals(b, p, energy))
+        energy = _absorbed(b, pushed - resisted)
+    return resisted, energy
 
 
 def _absorbed(b: Braking, torque: np.ndarray) -> np.ndarray:
@@ -223,17 +184,6 @@ def _absorbed(b: Braking, torque: np.ndarray) -> np.ndarray:
     power = np.where(b.time_s > b.start_s - 0.1, np.clip(torque, 0, None), 0.0) \
         * np.clip(b.wheel, 0, None)
     return np.cumsum(power * dt)
-
-
-def flywheel_extra(b: Braking, p: RigParameters) -> np.ndarray:
-    """The force of the flywheel equation's slots at each sample of ``b`` [N], opposing the
-    motion beside the drag (the plant's ``flywheel_slot``, at the measured speed and load)."""
-    named = flywheel_extra_force(p.vector(), b.speed_m_s)
-    if not Slot.FLYWHEEL.occupied(p):
-        return named
-    measured = signals(b.time_s, b.wheel, b.speed_m_s, b.pressure, b.load,
-                       np.zeros(b.time_s.size), p)
-    return named + Slot.FLYWHEEL.value_of(p, measured)
 
 
 def measured_signals(b: Braking, p: RigParameters, energy: np.ndarray) -> np.ndarray:
@@ -291,7 +241,7 @@ def fit_brake_gain(runs: Sequence[Braking], p: RigParameters) -> list[Estimate]:
         torque.append(whole[m])
         pressure.append(b.pressure[m])
         energy.append(absorbed[m])
-    weight = _sample_weights(torque)
+    weight = sample_weights(torque)
     # a weighted row of r F_x − J_w ω̇ = k_b f(E) P: torque and pressure scaled, E as it is
     t, pr = (np.concatenate(column) * weight for column in (torque, pressure))
     e = np.concatenate(energy)

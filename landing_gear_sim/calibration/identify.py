@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration import flywheel
 from landing_gear_sim.calibration.actuator import (
     FrfEstimate,
     fit_actuator_dynamics,
@@ -166,7 +167,7 @@ def _braking_steps(state: _Calibration, runs: Sequence[ClassifiedRun], fix_theta
     state.step("unloaded rolling radius", runs, "braking",
                lambda: state.adopt([br.fit_unloaded_radius(prepared, state.params)]))
     state.step("flywheel inertia and drag", runs, "braking",
-               lambda: state.adopt(br.fit_flywheel(prepared, state.params)))
+               lambda: state.adopt(flywheel.fit_flywheel(prepared, state.params)))
     state.step("brake gain", runs, "braking",
                lambda: state.adopt(br.fit_brake_gain(prepared, state.params)))
     if friction:

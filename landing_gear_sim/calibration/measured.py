@@ -13,7 +13,6 @@ from collections.abc import Sequence
 import numpy as np
 
 from landing_gear_sim.calibration.runs import ClassifiedRun, classified
-from landing_gear_sim.calibration.slots import Slot
 from landing_gear_sim.calibration.wheel_angle import (
     brake_run_phases,
     free_rolling,
@@ -21,12 +20,11 @@ from landing_gear_sim.calibration.wheel_angle import (
     measured_angle_rad,
     run_phases,
 )
-from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
-from landing_gear_sim.model.elements import load_lift, valve_static_pressure
+from landing_gear_sim.model.elements import valve_static_pressure
 from landing_gear_sim.model.integrate import SimulationResult, simulate
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.model.quantities import at_static_load, rim_speed_m_s
+from landing_gear_sim.model.quantities import at_static_load, load_taken_at, rim_speed_m_s
 from landing_gear_sim.model.scenario import Scenario, logged_to_held
 from landing_gear_sim.model.sensors import SensorModel
 from landing_gear_sim.processes import map_threads
@@ -102,21 +100,8 @@ def run_static_load_n(run: ClassifiedRun, params: RigParameters) -> float | None
     if mask.sum() < STATIC_LOAD_SAMPLES:
         return None
     speed = rim_speed_m_s(params, run.flywheel_speed_rad_s[mask])
-    return float(np.mean(run.vertical_load_n[mask] + load_lift(params.vector(), speed)
-                         + loading_slot_at(params, run.time_s[mask] - run.time_s[0], speed)))
-
-
-def loading_slot_at(params: RigParameters, time_s: np.ndarray, speed_m_s: np.ndarray
-                    ) -> np.ndarray:
-    """What the loading equation's slot takes off the set point at the run's ``time_s``
-    (from its first sample) and speeds [N] (0 unless a diagnosis found a term)."""
-    if not Slot.LOADING.occupied(params):
-        return np.zeros_like(speed_m_s)
-    measured = np.zeros((speed_m_s.size, basis.N_SIGNALS))
-    measured[:, basis.SPEED] = speed_m_s
-    measured[:, basis.CONTACT_TIME] = np.maximum(
-        time_s - params.number(K.RIG_TEST_TOUCHDOWN_S), 0.0)
-    return Slot.LOADING.value_of(params, measured)
+    return float(np.mean(run.vertical_load_n[mask]
+                         + load_taken_at(params, run.time_s[mask] - run.time_s[0], speed)))
 
 
 def _at_run_load(params: RigParameters, run: ClassifiedRun) -> RigParameters:

@@ -102,6 +102,12 @@ def run_weights(lengths: Sequence[int]) -> np.ndarray:
     return np.sqrt(np.minimum(1.0, np.median(n) / np.maximum(n, 1.0)))
 
 
+def sample_weights(per_run: Sequence[np.ndarray]) -> np.ndarray:
+    """Each sample's run weight (:func:`run_weights`), shape (total samples,)."""
+    sizes = [values.size for values in per_run]
+    return np.repeat(run_weights(sizes), sizes)
+
+
 def input_timing_std_s(runs: Sequence[Run]) -> float:
     """1-σ of when the logged current's changes really happened [s]: the logger shows a
     change at the first sample after it, anywhere within a period (uniform: T/√12). A

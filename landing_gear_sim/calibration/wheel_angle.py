@@ -32,7 +32,6 @@ from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.statistics import linear_std
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.model.quantities import rolling_radius_at
 from landing_gear_sim.model.sensors import RUNOUT_KEYS, SensorModel, wheel_angle_rad
 
 ORDERS = (1, 2)  # ripples per revolution
@@ -206,8 +205,9 @@ def brake_ripple_design(run: ClassifiedRun, params: RigParameters,
     wheel = br.lowpass(wheel, rate, cutoff)
     force = br.lowpass(sensors.true_longitudinal(run.longitudinal_force_n, run.vertical_load_n,
                                                  br.run_time_s(run)), rate, cutoff)
-    torque = rolling_radius_at(params, b.load) * force - params.number(
-        K.WHEEL_INERTIA_KG_M2) * np.gradient(wheel, 1.0 / rate)
+    # the wheel's balance read at the ripple's bandwidth: its own wheel and F_x, the rest b's
+    torque, _ = br.torque_balance(dataclasses.replace(
+        b, wheel=wheel, wheel_rate=np.gradient(wheel, 1.0 / rate), force=force), params)
     _, energy = br.torque_balance(b, params)
     mask = br.braking_samples(b) & (wheel > MIN_SPEED_RAD_S) & (br.slip(b, params) < MAX_SLIP)
     if mask.sum() < MIN_SAMPLES:

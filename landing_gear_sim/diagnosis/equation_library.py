@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration import flywheel as fly
 from landing_gear_sim.calibration import friction
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.slots import Slot, seen
@@ -48,7 +49,12 @@ from landing_gear_sim.model import basis
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.model.quantities import friction_coefficients, load_factor_at
+from landing_gear_sim.model.quantities import (
+    curve_at,
+    friction_coefficients,
+    load_factor_at,
+    load_taken_at,
+)
 from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.units import display, signed
 
@@ -119,7 +125,7 @@ class FlywheelLibrary(BrakingLibrary):
             return None
         dt = np.diff(b.time_s, prepend=b.time_s[0])
         speed = b.speed_m_s
-        balance = momentum_balance(b, params)
+        balance = fly.momentum_balance(b, params)
         impulse = balance - el.translational_mass(params.vector()) * speed
         measured = seen(Slot.FLYWHEEL, br.measured_signals(b, params, np.zeros(speed.size)))
         everywhere = np.arange(speed.size)
@@ -173,7 +179,7 @@ class LoadingLibrary(BrakingLibrary):
         speed = b.speed_m_s[index]
         measured = seen(Slot.LOADING, br.measured_signals(b, params, np.zeros(b.time_s.size))
                         [index])
-        taken = el.load_lift(params.vector(), speed) + Slot.LOADING.value_of(params, measured)
+        taken = load_taken_at(params, b.time_s[index], speed)
         # the set point the servo was following: the load led by its lag (a set point that
         # falls with v² is followed τ late, 120 N at 60 m/s braking at 8 m/s²)
         tau = params.number(K.LOADING_SERVO_TIME_CONSTANT_S)
@@ -253,7 +259,7 @@ class LockedTyreLibrary(TyreLibrary):
         _, curve_mu = friction.samples_at(b, params, index)
         factor = load_factor_at(params, b.load[index])
         slip = np.ones(index.size)
-        model = el.burckhardt_mu(*friction_coefficients(params), slip)
+        model = curve_at(params, slip, b.speed_m_s[index])
         signals = friction.tyre_signals(b, params, index)
         signals[:, basis.SLIP], signals[:, basis.CURVE] = slip, model
         return about_run_mean((curve_mu - model) * factor,
@@ -335,16 +341,6 @@ class FxChannelLibrary(Library[tuple[ClassifiedRun, "br.Braking | None"]]):
         return f"F_x,read = F_x{shown} {written}"
 
 
-def momentum_balance(b: br.Braking, params: RigParameters) -> np.ndarray:
-    """The flywheel's momentum balance from the run's start, m_f v + ∫(F_x + α_d v² + F_f)
-    dt, (n,) [N s]: constant where the model holds, whatever it misses integrated."""
-    p = params.vector()
-    dt = np.diff(b.time_s, prepend=b.time_s[0])
-    speed = b.speed_m_s
-    resisting = b.force + el.drag_forces(p, speed) + br.flywheel_extra(b, params)
-    return el.translational_mass(p) * speed + np.cumsum(resisting * dt)
-
-
 BALANCE_WINDOW_S = 1.0  # the flywheel's speed noise over m_f·Δv falls with the window
 
 
@@ -373,7 +369,7 @@ def _balance_windows(b: br.Braking, params: RigParameters, terms: Sequence[Term[
     speed = b.speed_m_s[span]
     time = br.run_time_s(b.run)
     values = np.column_stack([
-        momentum_balance(b, params)[span],
+        fly.momentum_balance(b, params)[span],
         np.cumsum(term_columns(terms, source, params, span, _fx_signals(b.run, time, span))
                   * dt[:, None], axis=0),
         el.translational_mass(p) * speed, np.cumsum(speed * speed * dt)])

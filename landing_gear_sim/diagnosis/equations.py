@@ -18,11 +18,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration import flywheel as fly
 from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
 from landing_gear_sim.diagnosis import residuals as rs
 from landing_gear_sim.diagnosis.findings import Signature, SignatureKind
 from landing_gear_sim.diagnosis.relations import Relation
-from landing_gear_sim.model import elements as el
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.run import Run
 
@@ -114,11 +114,7 @@ def equation_errors(run: ClassifiedRun, params: RigParameters, simulated: Run
     b = br.prepare(run, params)
     torque, energy = br.torque_balance(b, params)
     wheel = torque - br.model_torque(b, params, energy, np.arange(b.time_s.size))
-    p = params.vector()
-    speed = b.speed_m_s[window]
-    drag = el.drag_forces(p, speed) + br.flywheel_extra(b, params)[window]
-    flywheel = el.translational_mass(p) * np.gradient(b.speed_m_s, 1.0 / run.rate_hz)[window] \
-        + b.force[window] + drag
+    flywheel = fly.balance_error(b, params)[window]
     loading = run.vertical_load_n - simulated.vertical_load_n
     return [EquationError(e, run.name, values, run.rate_hz) for e, values in (
         (Equation.VALVE, valve[window]), (Equation.WHEEL, wheel[window]),

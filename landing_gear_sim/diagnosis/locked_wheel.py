@@ -22,8 +22,8 @@ from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.friction import tyre_carries
 from landing_gear_sim.calibration.statistics import linear_std
 from landing_gear_sim.diagnosis.relations import Check, Relation
-from landing_gear_sim.model import elements as el
 from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.quantities import tyre_friction_at
 
 LOCKED_RAD_S = 0.5  # the wheel is locked below this (filtered, and raw all around)
 AROUND_S = 0.1  # ... the raw channel reads no more than that within this window
@@ -40,12 +40,10 @@ def locked_sliding(runs: Sequence[br.Braking], params: RigParameters) -> Check |
     """The locked wheel's μ over the model's μ(λ = 1), its relative change over the speeds
     it slid at (a trend within each run, beside a level of each run's own); None where the
     wheel never locks long enough, over too few speeds."""
-    p = params.vector()
     ratios, speeds, runs_of = [], [], []
     for i, b in enumerate(runs):
         m = locked_samples(b, params)
-        model = np.array([el.tyre_friction(p, 1.0, v, f) for v, f in
-                          zip(b.speed_m_s[m], b.load[m], strict=True)])
+        model = tyre_friction_at(params, np.ones(m.size), b.speed_m_s[m], b.load[m])
         m, model = m[model > MIN_MU], model[model > MIN_MU]  # a curve that hardly grips there
         ratios.append(b.force[m] / (b.load[m] * model) - 1.0)
         speeds.append(b.speed_m_s[m])

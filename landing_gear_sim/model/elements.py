@@ -121,13 +121,38 @@ def tyre_friction(p, slip, speed_m_s, vertical_load_n):
     λ < 0 (wheel faster than hub). Below ``friction.change_speed_m_s`` (when > 0) the tyre
     is on the second surface: a stop decelerates monotonically, so a speed marks a place on
     the runway."""
-    first = THETA1
-    if p[CHANGE_SPEED] > 0.0 and speed_m_s < p[CHANGE_SPEED]:
-        first = AFTER_THETA1
-    curve = burckhardt_mu(p[first], p[first + 1], p[first + 2], abs(slip))
+    curve = tyre_curve(p, abs(slip), speed_m_s)
     mu = curve * load_factor(p, vertical_load_n) + tyre_slot(p, slip, speed_m_s,
                                                              vertical_load_n, curve)
     return mu if slip >= 0.0 else -mu
+
+
+@njit(cache=True, inline="always")
+def tyre_curve(p, slip, speed_m_s):
+    """μ_B(λ) of the surface under the tyre at speed ``speed_m_s``, λ ≥ 0: the first
+    surface's curve, or below ``friction.change_speed_m_s`` (when > 0) the second's."""
+    first = THETA1
+    if p[CHANGE_SPEED] > 0.0 and speed_m_s < p[CHANGE_SPEED]:
+        first = AFTER_THETA1
+    return burckhardt_mu(p[first], p[first + 1], p[first + 2], slip)
+
+
+@njit(cache=True)
+def tyre_curves(p, slip, speed_m_s):
+    """:func:`tyre_curve` of each sample of two arrays (n,)."""
+    out = np.empty(slip.shape[0])
+    for i in range(out.shape[0]):
+        out[i] = tyre_curve(p, slip[i], speed_m_s[i])
+    return out
+
+
+@njit(cache=True)
+def tyre_frictions(p, slip, speed_m_s, vertical_load_n):
+    """:func:`tyre_friction` of each sample of three arrays (n,)."""
+    out = np.empty(slip.shape[0])
+    for i in range(out.shape[0]):
+        out[i] = tyre_friction(p, slip[i], speed_m_s[i], vertical_load_n[i])
+    return out
 
 
 @njit(cache=True, inline="always")
@@ -248,9 +273,47 @@ def drag_forces(p, speed_m_s):
 
 @njit(cache=True)
 def flywheel_extra_force(p, speed_m_s):
-    """The flywheel equation's generic slot: F₀ sgn v + F₁ v, a force opposing the motion
+    """The flywheel equation's named slot: F₀ sgn v + F₁ v, a force opposing the motion
     beside the drag (0 on the reference rig; floats or arrays)."""
     return p[FLY_EXTRA_0] * np.sign(speed_m_s) + p[FLY_EXTRA_1] * speed_m_s
+
+
+@njit(cache=True)
+def flywheel_slot(p, speed_m_s, vertical_load_n):
+    """The flywheel equation's generic slot (``model.basis``): Σ c_k φ_k(v, F_z) [N]
+    opposing the motion: its bearings carry the load the tyre presses on the rim."""
+    return basis.slot_value(p, FLYWHEEL_SLOT, (0.0, speed_m_s, 0.0, vertical_load_n, 0.0, 0.0,
+                                               0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+
+
+@njit(cache=True)
+def flywheel_bearing_force(p, speed_m_s, vertical_load_n):
+    """The force of the flywheel equation's slots [N], opposing the motion beside the drag:
+    the named F₀ sgn v + F₁ v and the generic Σ c_k φ_k(v, F_z)."""
+    force = flywheel_extra_force(p, speed_m_s)
+    if basis.slot_acts(p, FLYWHEEL_SLOT):  # a call, not inlined: inlined it cost 3 %
+        force += flywheel_slot(p, speed_m_s, vertical_load_n)
+    return force
+
+
+@njit(cache=True)
+def flywheel_resistance(p, speed_m_s, vertical_load_n):
+    """What resists the flywheel beside the tyre's F_x in its balance m_f·v̇ = −F_x − F_r
+    [N]: the drag and the equation's slots. The one definition the plant, the calibration
+    and the diagnosis read the flywheel's balance through."""
+    return drag_force(p, speed_m_s) + flywheel_bearing_force(p, speed_m_s, vertical_load_n)
+
+
+@njit(cache=True)
+def flywheel_resistances(p, speed_m_s, vertical_load_n, with_drag):
+    """:func:`flywheel_resistance` of each sample of two arrays (n,) [N] (without the drag
+    when ``with_drag`` is False: a fit of α_d reads the rest)."""
+    out = np.empty(speed_m_s.shape[0])
+    for i in range(out.shape[0]):
+        out[i] = flywheel_bearing_force(p, speed_m_s[i], vertical_load_n[i])
+        if with_drag:
+            out[i] += drag_force(p, speed_m_s[i])
+    return out
 
 
 @njit(cache=True)
@@ -354,8 +417,24 @@ def vertical_load_reference(p, time_s, speed_m_s):
         return 0.0
     ramp = p[TOUCHDOWN_RAMP]
     scale = 1.0 if ramp <= 0.0 or elapsed >= ramp else elapsed / ramp
-    return scale * max(p[LOAD_STATIC] - load_lift(p, speed_m_s)
-                       - loading_slot(p, speed_m_s, elapsed), 0.0)
+    return scale * max(p[LOAD_STATIC] - load_taken(p, speed_m_s, elapsed), 0.0)
+
+
+@njit(cache=True)
+def load_taken(p, speed_m_s, contact_time_s):
+    """What the loading device's set point F_z0 loses at speed ``speed_m_s`` and
+    ``contact_time_s`` after touch-down [N]: :func:`load_lift` and the generic slot. The one
+    definition the plant, the calibration and the diagnosis read the loading law through."""
+    return load_lift(p, speed_m_s) + loading_slot(p, speed_m_s, contact_time_s)
+
+
+@njit(cache=True)
+def loads_taken(p, speed_m_s, contact_time_s):
+    """:func:`load_taken` of each sample of two arrays (n,) [N]."""
+    out = np.empty(speed_m_s.shape[0])
+    for i in range(out.shape[0]):
+        out[i] = load_taken(p, speed_m_s[i], contact_time_s[i])
+    return out
 
 
 @njit(cache=True)

@@ -80,22 +80,11 @@ def wheel_extra(p, x, pressure_pa, vertical_load_n, slip):
 
 
 @njit(cache=True)
-def flywheel_slot(p, x, vertical_load_n):
-    """The force of the flywheel equation's generic slot at state ``x`` [N], opposing the
-    motion beside the drag: its bearings carry the load the tyre presses on the rim."""
-    signals = (0.0, x[SPEED], 0.0, vertical_load_n, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
-               0.0)
-    return basis.slot_value(p, el.FLYWHEEL_SLOT, signals)
-
-
-@njit(cache=True)
 def derivatives(p, x, pressure_pa, vertical_load_n, dx):
     """Write dx/dt of the plant state into ``dx`` (eqs. 1-8; rig or aircraft form)."""
     radius, hub, slip, fx = tyre_state(p, x, vertical_load_n)
     tb = el.brake_torque(p, pressure_pa, x[E_BRAKE], x[OMEGA], x[WHEEL_ANGLE])
-    drag = el.drag_force(p, x[SPEED]) + el.flywheel_extra_force(p, x[SPEED])
-    if basis.slot_acts(p, el.FLYWHEEL_SLOT):  # a call, not inlined: inlined it cost 3 %
-        drag += flywheel_slot(p, x, vertical_load_n)
+    drag = el.flywheel_resistance(p, x[SPEED], vertical_load_n)
     mass = el.translational_mass(p)
     if p[el.HAS_GEAR_WALK] == 0.0:
         accel, angle_accel = (-fx - drag) / mass, 0.0

@@ -34,6 +34,23 @@ def friction_at(params: RigParameters, slip: np.ndarray) -> np.ndarray:
     return el.burckhardt_mu(*friction_coefficients(params), np.asarray(slip, dtype=float))
 
 
+def curve_at(params: RigParameters, slip: np.ndarray, speed_m_s: np.ndarray) -> np.ndarray:
+    """μ_B(λ) of the surface under the tyre at each sample (λ ≥ 0; the second surface below
+    the change speed), the plant's curve: :func:`~landing_gear_sim.model.elements.
+    tyre_curve`."""
+    return el.tyre_curves(params.vector(), np.ascontiguousarray(slip, dtype=float),
+                          np.ascontiguousarray(speed_m_s, dtype=float))
+
+
+def tyre_friction_at(params: RigParameters, slip: np.ndarray, speed_m_s: np.ndarray,
+                     load_n: np.ndarray) -> np.ndarray:
+    """The plant's μ(λ, v, F_z) at each sample: the curve under the tyre, its load factor
+    and the tyre's slot (:func:`~landing_gear_sim.model.elements.tyre_friction`)."""
+    return el.tyre_frictions(params.vector(), np.ascontiguousarray(slip, dtype=float),
+                             np.ascontiguousarray(speed_m_s, dtype=float),
+                             np.ascontiguousarray(load_n, dtype=float))
+
+
 def load_factor_at(params: RigParameters, load_n: np.ndarray) -> np.ndarray:
     """μ's factor 1 − κ (F_z − F_ref) for the tyre's load sensitivity at each vertical load
     [N], same shape (ones when κ = 0)."""
@@ -101,11 +118,35 @@ def at_static_load(params: RigParameters, static_load_n: float,
 
 def logged_or_set_load_n(run: Run, params: RigParameters) -> np.ndarray:
     """The run's vertical load [N], or where the logger had no load cell the loading
-    device's set point F_z0 − k_L·v² at the flywheel's speed (the static load alone left a
-    stop's slip rms 29 % off: the radius follows the load the lift takes off)."""
+    device's set point F_z0 − :func:`load_taken_at` at the flywheel's speed (the static load
+    alone left a stop's slip rms 29 % off: the radius follows the load the lift takes off)."""
     if "vertical_load_n" not in run.absent:
         return run.vertical_load_n
     static = np.full(len(run), params.number(K.LOADING_STATIC_LOAD_N))
     if "flywheel_speed_rad_s" in run.absent:
         return static
-    return static - el.load_lift(params.vector(), rim_speed_m_s(params, run.flywheel_speed_rad_s))
+    return static - load_taken_at(params, run.time_s - run.time_s[0],
+                                  rim_speed_m_s(params, run.flywheel_speed_rad_s))
+
+
+def load_taken_at(params: RigParameters, run_time_s: np.ndarray, speed_m_s: np.ndarray
+                  ) -> np.ndarray:
+    """What the loading device's set point F_z0 loses at each sample [N]: the lift and the
+    loading equation's slot (:func:`~landing_gear_sim.model.elements.load_taken`), at the
+    speed and the time since the model's touch-down (``run_time_s``: since the run's first
+    sample)."""
+    contact = np.maximum(np.asarray(run_time_s, dtype=float)
+                         - params.number(K.RIG_TEST_TOUCHDOWN_S), 0.0)
+    speed = np.asarray(speed_m_s, dtype=float)
+    return el.loads_taken(params.vector(), np.ascontiguousarray(speed),
+                          np.ascontiguousarray(contact))
+
+
+def flywheel_resistance_at(params: RigParameters, speed_m_s: np.ndarray, load_n: np.ndarray,
+                           with_drag: bool = True) -> np.ndarray:
+    """What resists the flywheel beside F_x at each sample [N] (its drag, unless
+    ``with_drag`` is False, and its slots: :func:`~landing_gear_sim.model.elements.
+    flywheel_resistance`)."""
+    return el.flywheel_resistances(
+        params.vector(), np.ascontiguousarray(speed_m_s, dtype=float),
+        np.ascontiguousarray(load_n, dtype=float), with_drag)

@@ -1,0 +1,199 @@
+"""The verdict guard of a refactor: what the diagnosis answers on a fixed set of campaigns,
+kept before a change and compared after it.
+
+Run: ``python bench/verdicts.py --save out/verdicts/before.json`` on the code before, then
+``python bench/verdicts.py --against out/verdicts/before.json`` after each step. A
+campaign's answer is its verdict and, per finding, its cause (family, equation) and key
+parameters with their σ. After a step every verdict and every finding's cause must be the
+same, and each parameter must lie within its σ of the kept value (the larger of the two
+σ); the command lists every difference and exits 1 when there is one.
+
+The campaigns (``--sets``, default all):
+
+- ``independent``, ``unseen``: ``../shared/data`` (another simulator's campaigns, with the
+  ``without`` of their truth and the datasheet they carry);
+- ``bench``: ``bench/diagnose.py``'s generated campaigns and the two example campaigns;
+- ``outside``: the own outside-the-library sweep (``bench/detection.py``'s OUTSIDE causes,
+  its seeds, logged as its random loggers log).
+
+Generated campaigns are written once under ``--campaigns`` (default
+``out/verdicts/campaigns``) and read from there afterwards: the data stay those the kept
+answers were made on, whatever the change does to the generator. Each answer is written to
+the output file as it comes, so a stopped run started again does only the rest.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import detection
+import diagnose as bench_diagnose
+import independent
+import numpy as np
+
+from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
+from landing_gear_sim.diagnosis.diagnose import diagnose
+from landing_gear_sim.model.parameters import load_parameters
+from msg_tools.io import read_runs
+
+SETS = ("independent", "unseen", "bench", "outside")
+Answer = dict[str, object]
+
+
+@dataclass(frozen=True)
+class Campaign:
+    """One campaign of the guard: where its runs are, what to start without, its datasheet
+    (None: the reference rig's), and how to write it when it is generated."""
+
+    key: str
+    folder: Path
+    without: tuple[str, ...] = ()
+    datasheet: Path | None = None
+    make: Callable[[Path], None] | None = None
+
+
+def _shared(kind: str) -> Iterator[Campaign]:
+    folder = independent.FOLDER if kind == "independent" else independent.UNSEEN
+    for path in independent.campaigns(folder):
+        without = independent.expected(path).without if kind == "independent" else ()
+        yield Campaign(f"{kind}/{path.name}", path, without, independent.datasheet_of(path))
+
+
+def _bench(root: Path) -> Iterator[Campaign]:
+    base = load_parameters()
+    for i, (name, (effect, without, names, _)) in enumerate(bench_diagnose.CASES.items()):
+        def make(folder: Path, i: int = i, effect: dict = effect,
+                 names: tuple[str, ...] | None = names) -> None:
+            rig = rig_like(base, np.random.default_rng(500 + i)).replace(effect, "hidden effect")
+            generate_campaign(folder, rig, 500 + i, names)
+        slug = name.replace(" ", "_").replace(",", "")
+        yield Campaign(f"bench/{slug}", root / "bench" / slug, without, None, make)
+    for name in ("campaign_v1", "campaign_v2"):
+        if (bench_diagnose.SHARED / name).is_dir():
+            yield Campaign(f"bench/{name}", bench_diagnose.SHARED / name)
+
+
+def _outside(root: Path, seed: int = 1000, per_cause: int = 3) -> Iterator[Campaign]:
+    """detection.py's plan (its default causes and seeds), OUTSIDE causes only."""
+    causes = [*detection.CASES, *detection.FAMILIES, *detection.OUTSIDE]
+    for i, cause in enumerate(causes):
+        if cause not in detection.OUTSIDE:
+            continue
+        for j in range(per_cause):
+            number = seed + 17 * i + j
+
+            def make(folder: Path, cause: str = cause, number: int = number) -> None:
+                _write_outside(folder, cause, number)
+            yield Campaign(f"outside/{cause}-{number}", root / "outside" / f"{cause}-{number}",
+                           make=make)
+
+
+def _write_outside(folder: Path, cause: str, seed: int) -> None:
+    """The campaign detection.py diagnoses for (cause, seed) with --logger-realities."""
+    datasheet = load_parameters()
+    rng = np.random.default_rng(seed)
+    rig = rig_like(datasheet, rng)
+    rig = rig.replace(detection.OUTSIDE[cause][1](rng, datasheet), "hidden effect")
+    logger = detection.random_logger(np.random.default_rng([seed, 2]))
+    generate_campaign(folder, rig, seed, logger=logger)
+
+
+def plan(sets: list[str], root: Path) -> list[Campaign]:
+    chosen: list[Campaign] = []
+    for kind in sets:
+        chosen += list(_shared(kind) if kind in ("independent", "unseen") else
+                       _bench(root) if kind == "bench" else _outside(root))
+    return chosen
+
+
+def answer(campaign: Campaign) -> Answer:
+    """The diagnosis' verdict, and each finding's cause with its parameters and σ."""
+    if campaign.make is not None and not (campaign.folder / "generating-parameters.yaml"
+                                          ).is_file():
+        campaign.make(campaign.folder)
+    sheet = campaign.datasheet
+    start = load_parameters([sheet], over_reference=True) if sheet else load_parameters()
+    result = diagnose(read_runs([campaign.folder]).runs, start,
+                      without=list(campaign.without))
+    return {"verdict": result.verdict,
+            "findings": [{"cause": f.cause, "family": f.family, "equation": f.equation,
+                          "term": f.term, "parameters": dict(f.parameters),
+                          "uncertainty": dict(f.std)} for f in result.findings]}
+
+
+def differences(before: Answer, after: Answer) -> list[str]:
+    """How ``after`` differs from ``before``: verdict, causes, parameters beyond σ."""
+    if before["verdict"] != after["verdict"]:
+        return [f"verdict {before['verdict']} -> {after['verdict']}"]
+    was, now = before["findings"], after["findings"]
+    assert isinstance(was, list) and isinstance(now, list)
+    names = [[(f["cause"], f["family"], f["equation"]) for f in x] for x in (was, now)]
+    if names[0] != names[1]:
+        return [f"findings {names[0]} -> {names[1]}"]
+    found = []
+    for old, new in zip(was, now, strict=True):
+        for name, value in old["parameters"].items():
+            moved = new["parameters"].get(name, math.nan)
+            sigma = max(_sigma(old, name), _sigma(new, name))
+            if not abs(moved - value) <= sigma:
+                found.append(f"{old['cause']}.{name} {value:.6g} -> {moved:.6g} "
+                             f"(σ {sigma:.3g})")
+    return found
+
+
+def _sigma(finding: dict, name: str) -> float:
+    value = finding["uncertainty"].get(name)
+    return float(value) if value is not None and math.isfinite(value) else 0.0
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    what = parser.add_mutually_exclusive_group(required=True)
+    what.add_argument("--save", type=Path, help="write the answers here")
+    what.add_argument("--against", type=Path, help="compare with answers kept here")
+    parser.add_argument("--sets", default=",".join(SETS), help=f"of {', '.join(SETS)}")
+    parser.add_argument("--only", default="", help="only campaigns whose key contains this")
+    parser.add_argument("--campaigns", type=Path, default=Path("out/verdicts/campaigns"))
+    args = parser.parse_args()
+    unknown = set(args.sets.split(",")) - set(SETS)
+    if unknown:
+        parser.error(f"--sets: unknown {', '.join(sorted(unknown))}")
+    kept = json.loads(args.against.read_text(encoding="utf-8")) if args.against else {}
+    output = args.save or args.against.with_suffix(".after.json")
+    done = json.loads(output.read_text(encoding="utf-8")) if output.is_file() else {}
+    found = 0
+    for campaign in plan(args.sets.split(","), args.campaigns):
+        if args.only not in campaign.key:
+            continue
+        if args.against and campaign.key not in kept:
+            print(f"{campaign.key}: not kept, skipped", file=sys.stderr)
+            continue
+        if campaign.key not in done:
+            started = time.perf_counter()
+            done[campaign.key] = answer(campaign)
+            done[campaign.key]["seconds"] = round(time.perf_counter() - started, 1)
+            output.parent.mkdir(parents=True, exist_ok=True)
+            output.write_text(json.dumps(done, indent=1), encoding="utf-8")
+        now = done[campaign.key]
+        shown = " ".join(f"{f['cause']}({f['family'] or f['equation']})"
+                         for f in now["findings"])
+        line = f"{campaign.key:50s} {now['verdict']:12s} {shown}"
+        if args.against:
+            diff = differences(kept[campaign.key], now)
+            found += bool(diff)
+            line += "  SAME" if not diff else "  DIFFERS: " + "; ".join(diff)
+        print(line, flush=True)
+    if args.against:
+        print(f"{found} campaigns differ; answers in {output}")
+    return 1 if found else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -16,24 +16,19 @@ from landing_gear_sim.calibration.identify import identify
 from landing_gear_sim.calibration.logger import Logger
 from landing_gear_sim.calibration.runs import classify_all
 from landing_gear_sim.calibration.slots import Slot
-from landing_gear_sim.diagnosis import equation_library as eq
 from landing_gear_sim.diagnosis.catalogue import CATALOGUE
 from landing_gear_sim.diagnosis.consistency import (
-    FREE_ROLLING,
-    FRICTION_IN_LOAD,
-    RUN_DRIFT,
-    VALVE_DIRECTION,
-    WHEEL_ANGLE,
     check_campaign,
     unchecked_relations,
     under_floor,
 )
 from landing_gear_sim.diagnosis.diagnose import diagnose
+from landing_gear_sim.diagnosis.equations import registry as eq
+from landing_gear_sim.diagnosis.equations.tyre import locked_sliding
 from landing_gear_sim.diagnosis.families import HIDDEN
 from landing_gear_sim.diagnosis.library import Campaign
 from landing_gear_sim.diagnosis.local import local_gains
-from landing_gear_sim.diagnosis.locked_wheel import locked_sliding
-from landing_gear_sim.diagnosis.relations import violations
+from landing_gear_sim.diagnosis.relations import Relation, violations
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
@@ -80,9 +75,9 @@ def test_load_cell_crosstalk_the_calibration_swallows_is_discovered_and_measured
     fraction = rng.choice([-1, 1]) * rng.uniform(0.008, 0.03)
     runs = _with_crosstalk(clean_runs, fraction)
     before = check_campaign(runs, identify(runs, reference, jackknife=False).params)
-    assert FREE_ROLLING in {c.relation for c in violations(before)}
+    assert Relation.FREE_ROLLING in {c.relation for c in violations(before)}
     expected = fraction * np.mean([_free_rolling_load(r) for r in runs if r.braking])
-    deviation = next(c for c in violations(before) if c.relation == FREE_ROLLING).deviation
+    deviation = next(c for c in violations(before) if c.relation == Relation.FREE_ROLLING).deviation
     assert deviation == pytest.approx(expected, rel=0.1)
 
     result = diagnose(runs, reference)
@@ -94,8 +89,8 @@ def test_load_cell_crosstalk_the_calibration_swallows_is_discovered_and_measured
     assert finding.fit_after["longitudinal_force_n"] > finding.fit_before["longitudinal_force_n"]
     assert not {c.cause for c in result.candidates if c.accepted} & set(CATALOGUE)
     assert violations(result.consistency) == []
-    assert FREE_ROLLING in {c.relation for c in violations(result.consistency_calibrated)}
-    assert finding.evidence.startswith(f"called for by {FREE_ROLLING}")
+    assert Relation.FREE_ROLLING in {c.relation for c in violations(result.consistency_calibrated)}
+    assert finding.evidence.startswith(f"called for by {Relation.FREE_ROLLING}")
 
 
 def test_a_brake_gain_law_in_speed_outside_the_catalogue_is_discovered(reference, tmp_path):
@@ -165,7 +160,7 @@ def test_a_valve_with_play_is_discovered_as_input_history(reference, tmp_path):
     runs = read_campaign(tmp_path).runs
     calibrated = identify(classify_all(runs), reference, jackknife=False).params
     broken = {c.relation for c in violations(check_campaign(classify_all(runs), calibrated))}
-    assert VALVE_DIRECTION in broken
+    assert Relation.VALVE_DIRECTION in broken
     finding = _discovered_alone(diagnose(runs, reference), "input_history")
     assert finding.parameters["backlash_a"] == pytest.approx(backlash, rel=0.2)
 
@@ -201,9 +196,9 @@ def test_an_encoder_rippling_with_the_wheel_angle_is_discovered_as_wheel_angle(r
     runs = read_campaign(tmp_path).runs
     calibrated = identify(classify_all(runs), reference, jackknife=False).params
     broken = {c.relation for c in violations(check_campaign(classify_all(runs), calibrated))}
-    assert WHEEL_ANGLE in broken
+    assert Relation.WHEEL_ANGLE in broken
     finding = _discovered_alone(diagnose(runs, reference), "wheel_angle")
-    assert finding.evidence.startswith(f"called for by {WHEEL_ANGLE}")
+    assert finding.evidence.startswith(f"called for by {Relation.WHEEL_ANGLE}")
     assert set(finding.parameters) == {f"wheel_runout_{order}"}
     assert finding.parameters[f"wheel_runout_{order}"] == pytest.approx(size, rel=0.05)
 
@@ -220,9 +215,9 @@ def test_a_friction_law_in_load_the_curve_bent_to_is_discovered_as_load(referenc
                                             "load law"), 171, light=True)
     result = diagnose(read_campaign(tmp_path).runs, reference)
     finding = _discovered_alone(result, "load")
-    assert finding.evidence.startswith(f"called for by {FRICTION_IN_LOAD}")
+    assert finding.evidence.startswith(f"called for by {Relation.FRICTION_IN_LOAD}")
     assert finding.parameters["load_sensitivity_per_n"] == pytest.approx(kappa, rel=0.2)
-    assert FRICTION_IN_LOAD not in {c.relation for c in violations(result.consistency)}
+    assert Relation.FRICTION_IN_LOAD not in {c.relation for c in violations(result.consistency)}
 
 
 def test_a_slippery_rig_with_light_stops_stays_none_with_every_relation_checked(reference,
@@ -240,7 +235,7 @@ def test_a_slippery_rig_with_light_stops_stays_none_with_every_relation_checked(
     generate_campaign(tmp_path, rig, 1138, light=True)
     result = diagnose(read_campaign(tmp_path).runs, reference)
     assert result.verdict == "none", [f.evidence for f in result.findings]
-    load = [c for c in result.consistency_calibrated if c.relation == FRICTION_IN_LOAD]
+    load = [c for c in result.consistency_calibrated if c.relation == Relation.FRICTION_IN_LOAD]
     assert len(load) == 1 and not load[0].violated, load
     assert not violations(result.consistency_calibrated)
 
@@ -251,10 +246,10 @@ def test_one_static_load_leaves_the_friction_in_load_relation_unchecked(clean_ru
     static load the relation is not claimed either way, and the user is told what would
     check it."""
     checks = check_campaign(clean_runs, reference)
-    assert FRICTION_IN_LOAD not in {c.relation for c in checks}
-    assert RUN_DRIFT in {c.relation for c in checks}
+    assert Relation.FRICTION_IN_LOAD not in {c.relation for c in checks}
+    assert Relation.RUN_DRIFT in {c.relation for c in checks}
     [note] = unchecked_relations(clean_runs, checks)
-    assert note.startswith(f"{FRICTION_IN_LOAD}: not checked") and "--light-runs" in note
+    assert note.startswith(f"{Relation.FRICTION_IN_LOAD}: not checked") and "--light-runs" in note
 
 
 @pytest.mark.slow
@@ -305,7 +300,8 @@ def test_the_local_brake_gain_shows_a_law_in_speed_the_calibration_averaged(refe
 
 def test_the_valve_check_holds_on_a_clean_campaign(clean_runs, reference):
     calibrated = identify(clean_runs, reference, jackknife=False).params
-    valve = [c for c in check_campaign(clean_runs, calibrated) if c.relation == VALVE_DIRECTION]
+    valve = [c for c in check_campaign(clean_runs, calibrated)
+             if c.relation == Relation.VALVE_DIRECTION]
     assert len(valve) == 2 and not any(c.violated for c in valve)
 
 
@@ -324,7 +320,7 @@ def test_a_brake_that_wears_from_run_to_run_breaks_its_constancy(reference, tmp_
         generate_campaign(tmp_path, worn, 134 + i, [name])
     runs = classify_all(read_campaign(tmp_path).runs)
     checks = check_campaign(runs, identify(runs, reference, jackknife=False).params)
-    drift = next(c for c in checks if c.relation == RUN_DRIFT)
+    drift = next(c for c in checks if c.relation == Relation.RUN_DRIFT)
     assert drift.violated, drift.describe()
     expected = (1 - wear) ** (len(braking) - 1) - 1
     assert drift.deviation == pytest.approx(expected, rel=0.25)

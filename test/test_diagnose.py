@@ -25,9 +25,10 @@ from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.cli import main
 from landing_gear_sim.diagnosis.catalogue import CATALOGUE, gear_walk_key_parameters
 from landing_gear_sim.diagnosis.consistency import inconsistent
-from landing_gear_sim.diagnosis.diagnose import Diagnosis, diagnose, tried_again
+from landing_gear_sim.diagnosis.diagnose import Diagnosis, diagnose
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.relations import Check, Relation
+from landing_gear_sim.diagnosis.rounds import tried_again
 from landing_gear_sim.diagnosis.scoring import split_runs
 from landing_gear_sim.errors import DiagnosisError
 from landing_gear_sim.model.parameters import load_parameters

@@ -18,9 +18,10 @@ from landing_gear_sim.calibration.measured import run_static_load_n, simulate_al
 from landing_gear_sim.calibration.runs import classify_all
 from landing_gear_sim.calibration.slots import Slot
 from landing_gear_sim.calibration.wheel_angle import brake_ripple_design
-from landing_gear_sim.diagnosis import equation_library as eq
-from landing_gear_sim.diagnosis.equations import Equation, equation_errors
-from landing_gear_sim.diagnosis.locked_wheel import locked_samples, locked_sliding
+from landing_gear_sim.diagnosis.equations import Equation
+from landing_gear_sim.diagnosis.equations import registry as eq
+from landing_gear_sim.diagnosis.equations.placing import equation_errors
+from landing_gear_sim.diagnosis.equations.tyre import locked_samples, locked_sliding
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.quantities import logged_or_set_load_n

@@ -13,12 +13,13 @@ from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.calibration.identify import identify
 from landing_gear_sim.calibration.runs import classify_all
-from landing_gear_sim.diagnosis import equation_library as eq
 from landing_gear_sim.diagnosis.diagnose import diagnose
 from landing_gear_sim.diagnosis.equations import Equation
+from landing_gear_sim.diagnosis.equations import registry as eq
+from landing_gear_sim.diagnosis.equations.flywheel import flywheel_carries
 from landing_gear_sim.diagnosis.families import HIDDEN, REGISTRY
 from landing_gear_sim.diagnosis.families.equation_terms import EquationTerms
-from landing_gear_sim.diagnosis.flywheel_reads import flywheel_carries
+from landing_gear_sim.diagnosis.library import Campaign
 from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
@@ -94,7 +95,7 @@ def test_each_equation_finds_its_own_hidden_term_and_no_other(reference, tmp_pat
     drawn = hidden.draw(np.random.default_rng(sum(map(ord, case))), reference)
     dynamic = ("actuator_steps_sweep",) if family.library is eq.VALVE_DYNAMICS else ()
     runs, calibrated = _campaign(reference, tmp_path, 310, drawn, RUNS + dynamic)
-    campaign = eq.Campaign(runs, [br.prepare(r, calibrated) for r in runs if r.braking])
+    campaign = Campaign(runs, [br.prepare(r, calibrated) for r in runs if r.braking])
     found = {library.relation: {s.term.name: s.value
                                 for s in library.select(campaign, calibrated)}
              for library in eq.LIBRARIES}
@@ -146,13 +147,14 @@ def test_a_bent_map_still_gives_the_current_for_a_pressure(reference):
 def test_a_bearing_torque_the_model_holds_leaves_free_rolling_holding(reference, tmp_path):
     """The tyre pushes a bearing's torque before the brake acts: with the slot known the
     free-rolling relation holds; without it, it is violated."""
-    from landing_gear_sim.diagnosis.consistency import FREE_ROLLING, check_campaign
+    from landing_gear_sim.diagnosis.consistency import check_campaign
+    from landing_gear_sim.diagnosis.relations import Relation
 
     torque = float(np.random.default_rng(11).uniform(60.0, 120.0))
     runs, calibrated = _campaign(reference, tmp_path, 303, {K.WHEEL_EXTRA_TORQUE_N_M: torque})
     for known, broken in ((0.0, True), (torque, False)):
         model = calibrated.replace({K.WHEEL_EXTRA_TORQUE_N_M: known}, "bearing")
-        checks = [c for c in check_campaign(runs, model) if c.relation == FREE_ROLLING]
+        checks = [c for c in check_campaign(runs, model) if c.relation == Relation.FREE_ROLLING]
         assert checks and any(c.violated for c in checks) == broken, [
             c.describe() for c in checks]
 

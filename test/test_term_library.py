@@ -16,8 +16,8 @@ from landing_gear_sim.calibration.identify import identify
 from landing_gear_sim.calibration.logger import Logger
 from landing_gear_sim.calibration.runs import classify_all
 from landing_gear_sim.calibration.slots import SEES, Slot
-from landing_gear_sim.diagnosis import equation_library as eq
 from landing_gear_sim.diagnosis.diagnose import diagnose
+from landing_gear_sim.diagnosis.equations import registry as eq
 from landing_gear_sim.diagnosis.library import Campaign
 from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.diagnosis.start import starting_model
@@ -507,7 +507,7 @@ def test_every_relation_checks_the_one_equation_that_declares_it():
     """Relations were keyed to their equation in a table of strings apart from the
     equations; each equation now declares its relations, and a library checks a relation
     of its own equation."""
-    from landing_gear_sim.diagnosis.equations import DECLARED, declaring
+    from landing_gear_sim.diagnosis.equations.registry import DECLARED, declaring
     from landing_gear_sim.diagnosis.relations import Relation
 
     declared = [r for d in DECLARED.values() for r in d.relations]

@@ -25,7 +25,8 @@ from landing_gear_sim.diagnosis.catalogue import (
 )
 from landing_gear_sim.diagnosis.consistency import check_campaign
 from landing_gear_sim.diagnosis.diagnose import diagnose
-from landing_gear_sim.diagnosis.equations import Equation, EquationError, locate
+from landing_gear_sim.diagnosis.equations import Equation
+from landing_gear_sim.diagnosis.equations.placing import EquationError, locate
 from landing_gear_sim.diagnosis.families import HIDDEN, Evidence, gain_law
 from landing_gear_sim.diagnosis.findings import Signature, SignatureKind
 from landing_gear_sim.diagnosis.relations import Relation

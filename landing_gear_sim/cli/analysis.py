@@ -138,7 +138,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
 def _write_params(result: Identification, path: Path) -> None:
     """The params file; a partial one starts with the steps whose values were kept."""
-    from landing_gear_sim.diagnosis.equation_library import held_notes
+    from landing_gear_sim.diagnosis.equations.registry import held_notes
 
     header = ["PARTIAL identification (--partial): these steps did not run, their parameters "
               "keep the base values:", *(f"  {step}" for step in result.not_identified)

@@ -241,7 +241,7 @@ def cmd_bode(args: argparse.Namespace) -> int:
 
 
 def cmd_params(args: argparse.Namespace) -> int:
-    from landing_gear_sim.diagnosis.equation_library import held_notes
+    from landing_gear_sim.diagnosis.equations.registry import held_notes
 
     params = params_of(args)
     notes = held_notes(params)  # what a slot's code names: '37.0' alone says nothing

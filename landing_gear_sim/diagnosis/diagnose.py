@@ -1,48 +1,43 @@
-"""Diagnose: why the model and the rig disagree (docs/diagnosis.md).
+"""Diagnose: why the model and the rig disagree (docs/diagnosis.md). The stages:
 
 1. Calibrate the starting model on the campaign, so a parameter that is merely off
-   is re-tuned, not reported as missing physics.
-2. Score every candidate the starting model lacks (:mod:`~landing_gear_sim.diagnosis.scoring`):
-   fit it and its null on the runs that carry its signature, check both on the others.
-3. Adopt the best accepted candidate, re-calibrate with it, re-score the candidates that
-   had helped, repeat.
-4. What remains in the residuals (:mod:`~landing_gear_sim.diagnosis.signatures`) is
-   reported as ``unexplained`` with its signature, never given a name.
+   is re-tuned, not reported as missing physics (:func:`_calibrated_start`).
+2. Search the catalogue in rounds (:mod:`~landing_gear_sim.diagnosis.rounds`): score every
+   candidate the starting model lacks, adopt the best accepted one, re-calibrate with it,
+   re-score the candidates that had helped, repeat.
+3. Extend the model by a term of the rig's equations where their relations call for one
+   (:mod:`~landing_gear_sim.diagnosis.discovered`, :mod:`~landing_gear_sim.diagnosis.
+   equations`).
+4. Judge the verdict (:func:`_verdict`): what remains in the residuals
+   (:mod:`~landing_gear_sim.diagnosis.signatures`) or in the relations is reported as
+   ``unexplained`` in the equation that carries it, never given a name.
 """
-
 from __future__ import annotations
 
-import contextvars
-import multiprocessing
-import os
-from collections.abc import Callable, Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
-from dataclasses import dataclass, field, replace
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from landing_gear_sim.calibration.actuator import LATE
-from landing_gear_sim.calibration.identify import Progress, identify
+from landing_gear_sim.calibration.identify import Identification, Progress, identify
 from landing_gear_sim.calibration.measured import CHANNELS, simulate_all
 from landing_gear_sim.calibration.runs import ClassifiedRun, classify_all, fully_logged
 from landing_gear_sim.calibration.statistics import Estimate
-from landing_gear_sim.diagnosis import discovered
+from landing_gear_sim.diagnosis import discovered, rounds
 from landing_gear_sim.diagnosis.catalogue import (
     CATALOGUE,
     Candidate,
     Scales,
-    key_parameters,
     noise_scales,
-    switched_on,
 )
 from landing_gear_sim.diagnosis.consistency import (
-    check_campaign,
     coarse_channels,
     inconsistent,
     unchecked_relations,
     under_floor,
 )
-from landing_gear_sim.diagnosis.equations import locate_all
+from landing_gear_sim.diagnosis.equations.placing import locate_all
 from landing_gear_sim.diagnosis.findings import Finding, Signature
 from landing_gear_sim.diagnosis.identifiability import actuator_calibrated, untestable
 from landing_gear_sim.diagnosis.local import LocalGain, local_gains
@@ -55,8 +50,6 @@ from landing_gear_sim.diagnosis.scoring import (
     Scored,
     channel_fits,
     forget_null_fits,
-    key_std,
-    score_candidate,
 )
 from landing_gear_sim.diagnosis.signatures import (
     RunEvidence,
@@ -66,13 +59,12 @@ from landing_gear_sim.diagnosis.signatures import (
     window_regressors,
 )
 from landing_gear_sim.diagnosis.start import FRICTION_CURVE, starting_model
-from landing_gear_sim.errors import DiagnosisError, IdentificationError
+from landing_gear_sim.errors import DiagnosisError
 from landing_gear_sim.model.datasheet import datasheet_values
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.processes import busy_counter, pool_worker, single_threaded_blas, working
+from landing_gear_sim.processes import single_threaded_blas
 from msg_tools.run import Run
 
-MAX_ROUNDS = 4
 INCONCLUSIVE = "inconclusive"  # the verdict when the campaign cannot test every candidate
 
 
@@ -117,28 +109,6 @@ class Diagnosis:
                 "datasheet": datasheet_values(self.start)}
 
 
-class Consistency:
-    """The consistency checks of the models a diagnosis reads them under, each computed
-    once (:func:`check_campaign`). A round computes its model's while its candidates fit
-    (:meth:`meanwhile`): the calibrated model's are always read, and the last round's model
-    is the final one."""
-
-    def __init__(self, runs: Sequence[ClassifiedRun]) -> None:
-        self._runs = runs
-        self._done: list[tuple[RigParameters, list[Check]]] = []
-
-    def of(self, model: RigParameters) -> list[Check]:
-        """The checks under ``model``."""
-        for done, checks in self._done:
-            if done is model:
-                return checks
-        checks = check_campaign(self._runs, model)
-        self._done.append((model, checks))
-        return checks
-
-    def meanwhile(self, model: RigParameters) -> Callable[[], object]:
-        """A task computing the checks under ``model``, for :func:`_score_all`."""
-        return lambda: self.of(model)
 
 
 def candidates_for(start: RigParameters, without: Sequence[str]) -> list[Candidate]:
@@ -162,98 +132,141 @@ def diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str] = 
 
 def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
               progress: Progress | None) -> Diagnosis:
+    """The diagnosis as its stages: calibrate the starting model, search the catalogue in
+    rounds, extend the model by a discovered term, judge the verdict."""
     say = progress or (lambda _msg: None)
+    start = _calibrated_start(runs, base, without, say)
+    search = rounds.search(start.runs, start.start, start.without, start.calibrated, base,
+                           start.scales, start.before, start.pending, start.problems, say)
+    say("checking the relations the rig measures twice")
+    checks = search.consistency.of(search.model)
+    calibrated_checks = search.consistency.of(start.calibrated)
+    start.problems.extend(unchecked_relations(start.runs, calibrated_checks))
+    start.problems.extend(coarse_channels(start.runs, calibrated_checks))
+    story = discovered.Story(start.runs, start.calibrated, base, start.scales, start.tried,
+                             calibrated_checks, say)
+    model, accepted, checks = _extended(story, search, checks)
+    say("analysing the residuals of the extended model")
+    simulated_after = simulate_all(start.runs, model)
+    after = _interpretable(find_signatures(start.runs, model, simulated_after), start.runs)
+    verdict, findings = _verdict(start, search.table, accepted, model, checks,
+                                 simulated_after, after)
+    start.problems.extend(under_floor(checks))
+    problems = _answered(start.problems, search.table)
+    evidence = [run_evidence(*sims, start.calibrated) for sims in
+                zip(start.runs, start.simulated, simulated_after, strict=True)]
+    return Diagnosis(verdict, findings, search.table, start.baseline, start.start,
+                     start.calibrated, model, start.before, after, problems, evidence, checks,
+                     calibrated_checks, start.calibration.estimates,
+                     local_gains(start.runs, start.calibrated), local_gains(start.runs, model))
+
+
+@dataclass
+class _Start:
+    """What the search starts from: the runs, the starting model (and the elements it was
+    started without) and its calibration on them, their simulations and fits, the residual
+    signatures, the noise scales, the candidates the runs can test (and those they cannot
+    that could hide in what they show), and the problems noted so far."""
+
+    runs: Sequence[ClassifiedRun]
+    start: RigParameters
+    without: Sequence[str]
+    calibration: Identification
+    simulated: list[Run]
+    baseline: dict[str, float]
+    tried: list[Signature]
+    scales: Scales
+    pending: list[Candidate]
+    skipped: list[str]
+    problems: list[str]
+
+    @property
+    def calibrated(self) -> RigParameters:
+        return self.calibration.params
+
+    @property
+    def before(self) -> list[Signature]:
+        """The signatures found under the calibrated model, the tentative ones left out."""
+        return [s for s in self.tried if not s.tentative]
+
+
+def _calibrated_start(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
+                      say: Progress) -> _Start:
+    """Classify the runs, calibrate the starting model on them, read its residuals, and
+    choose the candidates the runs can test."""
     kept, left_out = fully_logged(classify_all(runs), "the diagnosis")  # once: kinds read
-    runs = kept
-    if not runs:
+    if not kept:
         raise DiagnosisError("no run to diagnose" + (f" ({'; '.join(left_out)})"
                                                       if left_out else ""))
     start = starting_model(base, without)
-    say(f"calibrating the starting model on {len(runs)} runs")
-    calibration = identify(runs, start, progress=say, friction=FRICTION_CURVE not in without,
+    say(f"calibrating the starting model on {len(kept)} runs")
+    calibration = identify(kept, start, progress=say, friction=FRICTION_CURVE not in without,
                            jackknife=False)
     problems = [*left_out, *calibration.problems]
-    calibrated = calibration.params
-    simulated_before = simulate_all(runs, calibrated)
-    baseline = baseline_fits(runs, simulated_before)
+    simulated = simulate_all(kept, calibration.params)
+    baseline = baseline_fits(kept, simulated)
     say("analysing the residuals of the calibrated model")
-    tried = _interpretable(find_signatures(runs, calibrated, simulated_before, tentative=True),
-                           runs)
-    before = [s for s in tried if not s.tentative]
-    scales = noise_scales(runs, tuple(CHANNELS))
-    pending, skipped = _testable(scaled_to_rig(candidates_for(start, without), runs, start),
-                                 runs, problems, say)
-    model = calibrated
-    consistency = Consistency(runs)
-    accepted: list[Scored] = []
-    table: list[Finding] = []
-    ended: dict[str, dict[str, float]] = {}  # where each candidate's fit ended, by cause
-    for round_ in range(1, MAX_ROUNDS + 1):
-        if not pending:
-            break
-        say(f"round {round_}: fitting {', '.join(c.cause for c in pending)}")
-        scored = []
-        for outcome in _score_all(pending, runs, model, base, scales, before, say,
-                                  consistency.meanwhile(model), ended):
-            if isinstance(outcome, str):
-                problems.append(outcome)
-            else:
-                scored.append(outcome)
-        winners = [s for s in scored if s.finding.accepted]
-        best = min(winners, key=lambda s: s.finding.delta_bic or 0.0) if winners else None
-        table.extend(replace(s.finding, round=round_, reason=_round_reason(s, best))
-                     for s in scored)
-        if best is None:
-            break
-        say(f"accepted {best.finding.cause}: {best.finding.evidence}")
-        accepted.append(best)
-        say(f"re-calibrating with {', '.join(s.finding.cause for s in accepted)}")
-        model, accepted = _recalibrate(runs, start, accepted, without)
-        ended = {s.finding.cause: s.fit.values for s in scored}
-        pending = tried_again(scored, best)
-    say("checking the relations the rig measures twice")
-    checks, calibrated_checks = consistency.of(model), consistency.of(calibrated)
-    problems.extend(unchecked_relations(runs, calibrated_checks))
-    problems.extend(coarse_channels(runs, calibrated_checks))
-    story = discovered.Story(runs, calibrated, base, scales, tried, calibrated_checks, say)
+    tried = _interpretable(find_signatures(kept, calibration.params, simulated,
+                                           tentative=True), kept)
+    scales = noise_scales(kept, tuple(CHANNELS))
+    pending, skipped = _testable(scaled_to_rig(candidates_for(start, without), kept, start),
+                                 kept, problems, say)
+    return _Start(kept, start, without, calibration, simulated, baseline, tried, scales,
+                  pending, skipped, problems)
+
+
+
+
+
+
+def _extended(story: discovered.Story, search: rounds.Search, checks: list[Check]
+              ) -> tuple[RigParameters, list[Scored], list[Check]]:
+    """The model extended by a discovered term where the equations call for one (the
+    search's own otherwise), its accepted causes and its relations' checks."""
+    model, accepted = search.model, search.accepted
     found = story.extend(accepted, model, checks)
-    if found is not None:
-        table.extend(found.tried)
-        if found.scored is not None:
-            model = found.scored.fit.params
-            accepted = [*(_refreshed(s, model) for s in found.kept), found.scored]
-            checks = consistency.of(model)
-    say("analysing the residuals of the extended model")
-    simulated_after = simulate_all(runs, model)
-    after = _interpretable(find_signatures(runs, model, simulated_after), runs)
+    if found is None:
+        return model, accepted, checks
+    search.table.extend(found.tried)
+    if found.scored is None:
+        return model, accepted, checks
+    model = found.scored.fit.params
+    accepted = [*(rounds.refreshed(s, model) for s in found.kept), found.scored]
+    return model, accepted, search.consistency.of(model)
+
+
+def _verdict(start: _Start, table: list[Finding], accepted: list[Scored],
+             model: RigParameters, checks: list[Check], simulated_after: list[Run],
+             after: list[Signature]) -> tuple[str, list[Finding]]:
+    """The verdict and its findings: the accepted causes, then what remains unexplained in
+    the residuals and the relations; ``inconclusive`` where a candidate the runs could not
+    test may be what they show."""
     findings = [s.finding for s in accepted]
     unchecked = _unchecked(table) if not accepted else []
-    problems.extend(f"{f.cause} ({_in_words(f.parameters)}): fits the runs it was fitted on "
-                    f"better (ΔBIC {f.delta_bic:+.0f}) but no run is left to check it on: one "
-                    f"more run like {(*f.fitted_on, 'those')[0]} would settle it"
-                    for f in unchecked)
-    problems.extend(_unsettled_in_time(table) if not accepted else [])
-    if accepted or not (skipped or unchecked):
-        if after:
-            places = locate_all(after, runs, model, simulated_after,
-                                lambda run, sim: window_regressors(run, sim, model))
-            findings.append(unexplained(after, baseline_fits(runs, simulated_after), places))
-        if broken := structural(checks):
-            findings.append(inconsistent(broken))
-        verdict = findings[0].cause if findings else "none"
-    else:
+    start.problems.extend(
+        f"{f.cause} ({_in_words(f.parameters)}): fits the runs it was fitted on better "
+        f"(ΔBIC {f.delta_bic:+.0f}) but no run is left to check it on: one more run like "
+        f"{(*f.fitted_on, 'those')[0]} would settle it" for f in unchecked)
+    start.problems.extend(_unsettled_in_time(table) if not accepted else [])
+    if not accepted and (start.skipped or unchecked):
         # not 'none' (a catalogued effect may hide in what could not be tested), and no
         # 'unexplained' either: an untested candidate may be what the residual shows
-        verdict = INCONCLUSIVE
-    problems.extend(under_floor(checks))
-    if any(f.cause == "actuator_delay" for f in table):  # the calibration's hint, answered
-        problems = [p for p in problems if LATE not in p]
-    evidence = [run_evidence(*sims, calibrated)
-                for sims in zip(runs, simulated_before, simulated_after, strict=True)]
-    return Diagnosis(verdict, findings, table, baseline, start, calibrated, model,
-                     before, after, problems, evidence, checks, calibrated_checks,
-                     calibration.estimates, local_gains(runs, calibrated),
-                     local_gains(runs, model))
+        return INCONCLUSIVE, findings
+    if after:
+        places = locate_all(after, start.runs, model, simulated_after,
+                            lambda run, sim: window_regressors(run, sim, model))
+        findings.append(unexplained(after, baseline_fits(start.runs, simulated_after), places))
+    if broken := structural(checks):
+        findings.append(inconsistent(broken))
+    return (findings[0].cause if findings else "none"), findings
+
+
+def _answered(problems: list[str], table: Sequence[Finding]) -> list[str]:
+    """``problems`` less the calibration's hint of a late valve, where the diagnosis tried
+    the delay that answers it."""
+    if any(f.cause == "actuator_delay" for f in table):
+        return [p for p in problems if LATE not in p]
+    return problems
 
 
 def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],
@@ -272,24 +285,8 @@ def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],
     return testable, [c for c in skipped if _could_show(CATALOGUE[c], runs)]
 
 
-def tried_again(scored: Sequence[Scored], best: Scored) -> list[Candidate]:
-    """The candidates of a round tried again on the model with its ``best``: every other
-    that met the evidence (ΔBIC below the threshold). A cause masked by another shows once
-    that one is in (I02's offset: ΔBIC −46 beside the delay, −5622 once it was in); one short
-    of the evidence is not tried again: in the plans of bench/detection.py (stops 56, 57)
-    none of the six so tried grew significant, and I01's relaxation (ΔBIC −2, then +12)
-    cost 3.8 s of its 15."""
-    return [CATALOGUE[s.finding.cause] for s in scored
-            if s is not best and (s.finding.delta_bic or 0.0) < BIC_THRESHOLD]
 
 
-def _round_reason(scored: Scored, best: Scored | None) -> str:
-    """A candidate's reason in its round: one that meets every rule but another explained
-    more is tried again in the next round, on the model with that one."""
-    if best is None or scored is best or not scored.finding.accepted:
-        return scored.finding.reason
-    return (f"meets every rule, but {best.finding.cause} explains more (ΔBIC "
-            f"{best.finding.delta_bic:+.0f}): tried again on the model with it")
 
 
 def _could_show(candidate: Candidate, runs: Sequence[ClassifiedRun]) -> bool:
@@ -332,102 +329,12 @@ def _unsettled_in_time(table: Sequence[Finding]) -> list[str]:
             and all(name.endswith(f" ({CUT_LATER})") for name in f.checked_on)]
 
 
-def _score_one(candidate: Candidate, runs: Sequence[ClassifiedRun], model: RigParameters,
-               datasheet: RigParameters, scales: Scales,
-               signatures: Sequence[Signature], ended: Mapping[str, float] | None = None
-               ) -> Scored | str:
-    try:
-        with working():
-            return score_candidate(candidate, runs, model, datasheet, scales, signatures,
-                                   ended=ended)
-    except IdentificationError as exc:
-        return f"{candidate.cause}: not scored ({exc})"
 
 
-def _score_all(pending: Sequence[Candidate], runs: Sequence[ClassifiedRun], model: RigParameters,
-               datasheet: RigParameters, scales: Scales, signatures: Sequence[Signature],
-               say: Progress, meanwhile: Callable[[], object] = lambda: None,
-               ended: Mapping[str, Mapping[str, float]] | None = None) -> list[Scored | str]:
-    """Score the candidates, in parallel processes when there are cores to spare (each
-    fit is independent and single-threaded), each also from where it ``ended`` in a round
-    before (by cause); in order of ``pending``. ``meanwhile`` runs in this process as they
-    fit (its work is serial: the fits' threads leave room for it)."""
-    ended = ended or {}
-    workers = min(len(pending), os.cpu_count() or 1)
-    if workers < 2 or multiprocessing.current_process().daemon:
-        # a daemonic process (a Dask worker's) may not have children
-        meanwhile()
-        return [_score_one(c, runs, model, datasheet, scales, signatures,
-                           ended.get(c.cause)) for c in pending]
-    # fork: the children inherit the compiled physics instead of compiling it again
-    context = multiprocessing.get_context("fork")
-    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=pool_worker,
-                               initargs=(busy_counter(),))
-    side = ThreadPoolExecutor(1)
-    try:
-        # the costliest first (more fitted parameters: more simulations per step), so the
-        # last to finish is a short one
-        futures = {pool.submit(_score_one, c, runs, model, datasheet, scales, signatures,
-                               ended.get(c.cause)): c
-                   for c in sorted(pending, key=lambda c: -len({*c.keys, *c.free}))}
-        # on a thread only once the workers are forked: a fork while it holds a lock (an
-        # import's) would leave the child waiting on it; numpy's error state goes with it
-        beside = side.submit(contextvars.copy_context().run, meanwhile)
-        for future in as_completed(futures):
-            say(f"  {futures[future].cause} scored")
-        results = [next(f for f, c in futures.items() if c is candidate).result()
-                   for candidate in pending]
-        beside.result()
-    except BaseException:
-        # Ctrl-C or SIGTERM: the workers' fits could run for minutes; an executor's exit
-        # would wait for them
-        for child in multiprocessing.active_children():
-            child.terminate()
-        pool.shutdown(wait=False, cancel_futures=True)
-        side.shutdown(wait=False, cancel_futures=True)
-        raise
-    pool.shutdown()
-    side.shutdown()
-    return results
 
 
-def _recalibrate(runs: Sequence[ClassifiedRun], start: RigParameters, accepted: list[Scored],
-                 without: Sequence[str]) -> tuple[RigParameters, list[Scored]]:
-    """Calibrate the starting model again with the accepted elements in it: what they
-    had distorted is re-tuned, and identify estimates the keys it knows (the fade, the
-    drag, A(s)). The findings take the final values."""
-    seed = start
-    for s in accepted:
-        seed = switched_on(s.fit.candidate, seed).replace(
-            {k: s.fit.values[k] for k in s.fit.candidate.keys}, "accepted")
-    friction = FRICTION_CURVE not in without or any(
-        s.finding.cause == FRICTION_CURVE for s in accepted)
-    calibration = identify(runs, seed, friction=friction, jackknife=False)
-    model = calibration.params
-    estimated = {e.key: e for e in calibration.estimates}
-    out = []
-    for s in accepted:
-        candidate = s.fit.candidate
-        # keys identify does not estimate keep their candidate-fit values (a polish on
-        # all runs after the re-calibration drove the relaxation length to its bound:
-        # the re-fitted friction curve had absorbed it)
-        reported = {*candidate.keys, *(key for _, key in candidate.contract)}
-        std = {k: estimated[k].std if k in estimated else s.fit.std.get(k, 0.0)
-               for k in reported}
-        values = {k: model.number(k) for k in reported}
-        final = replace(s.fit, params=model, values=values, std=std)
-        finding = replace(s.finding, parameters=key_parameters(candidate, model),
-                          std=key_std(candidate, final))
-        out.append(Scored(finding, final))
-    return model, out
 
 
-def _refreshed(scored: Scored, model: RigParameters) -> Scored:
-    """A cause kept beside a discovered term, with its values in the final ``model`` (the
-    term's fit may have freed them: a delay beside a channel's skew)."""
-    candidate = scored.fit.candidate
-    return Scored(replace(scored.finding, parameters=key_parameters(candidate, model)),
-                  replace(scored.fit, params=model))
 
 
 def baseline_fits(runs: Sequence[ClassifiedRun], simulated: Sequence[Run]

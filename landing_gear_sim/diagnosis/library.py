@@ -4,7 +4,7 @@ A :class:`Library` is one equation of the rig: the runs that carry its error
 (:meth:`Library.sources`), its error there beside its terms and the terms the calibration owns
 (:meth:`Library.rows`, regression :class:`~.selection.Rows`), its law with terms written in,
 and its relation, checked by selecting the terms the error needs (:mod:`~.selection`). The
-equations themselves are in :mod:`~.equation_library` and :mod:`~.valve_library`.
+equations themselves are in :mod:`~.equations`, one module each.
 """
 
 from __future__ import annotations

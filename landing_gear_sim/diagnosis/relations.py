@@ -1,6 +1,7 @@
 """The relations the rig measures twice, as values: which relation, and one check of it on a
-run (or the campaign) against its noise and its physical floor. The checks themselves are in
-:mod:`~landing_gear_sim.diagnosis.consistency`."""
+run (or the campaign) against its noise and its physical floor. Each equation's module
+(:mod:`~landing_gear_sim.diagnosis.equations`) holds the checks of the relations it
+declares."""
 
 from __future__ import annotations
 
@@ -8,6 +9,10 @@ import enum
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+
+import numpy as np
+
+from landing_gear_sim.calibration.statistics import effective_count
 
 Z_VIOLATED = 6.0  # σ: with a dozen checks per campaign, no false alarm from noise
 MIN_SAMPLES = 200  # a check on fewer samples is not made ...
@@ -17,7 +22,8 @@ MIN_CHECK_S = 0.2  # ... or, where a log's rate matters, on less than this much 
 
 class Relation(str, enum.Enum):
     """A relation the rig measures twice, by its display text (compares equal to it); the
-    equation that declares it (``diagnosis.equations.DECLARED``) is the one it checks."""
+    equation that declares it (``diagnosis.equations.registry.DECLARED``) is the one it
+    checks."""
 
     FREE_ROLLING = "free rolling ⇒ F_x = J_w ω̇ / r"
     ZERO_CURRENT = "zero current ⇒ zero pressure"
@@ -94,6 +100,17 @@ class Check:
                 "deviation": self.deviation, "std": self.std, "floor": self.floor,
                 "unit": self.unit, "violated": self.violated,
                 "input_noise": self.input_noise}
+
+
+def mean_check(relation: Relation, run: str, phase: str, values: np.ndarray, floor: float,
+               unit: str, rate_hz: float) -> Check | None:
+    """A relation that says ``values`` are 0 on average, read as their mean with its 1-σ
+    (autocorrelation counted); None on less than MIN_CHECK_S of samples."""
+    if values.size < MIN_CHECK_S * rate_hz:
+        return None
+    mean = float(np.mean(values))
+    std = float(np.std(values)) / math.sqrt(effective_count(values - mean))
+    return Check(relation, run, phase, mean, std, floor, unit)
 
 
 def structural(checks: Sequence[Check]) -> list[Check]:

@@ -18,7 +18,7 @@ import numpy as np
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
 from landing_gear_sim.diagnosis import residuals as rs
-from landing_gear_sim.diagnosis.equations import Place
+from landing_gear_sim.diagnosis.equations.placing import Place
 from landing_gear_sim.diagnosis.findings import Finding, Signature, SignatureKind
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.elements import slip_ratio

@@ -8,7 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from landing_gear_sim.diagnosis.diagnose import Diagnosis
-from landing_gear_sim.diagnosis.equation_library import held_laws, held_notes
+from landing_gear_sim.diagnosis.equations.registry import held_laws, held_notes
 from landing_gear_sim.report.words import headline
 
 

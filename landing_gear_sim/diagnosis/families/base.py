@@ -23,8 +23,8 @@ import numpy as np
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun, Selector
 from landing_gear_sim.diagnosis.catalogue import Candidate
-from landing_gear_sim.diagnosis.equation_library import Campaign
 from landing_gear_sim.diagnosis.findings import Signature
+from landing_gear_sim.diagnosis.library import Campaign
 from landing_gear_sim.diagnosis.relations import Check, Relation, violations
 from landing_gear_sim.model.parameters import RigParameters
 

@@ -18,7 +18,8 @@ import numpy as np
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
-from landing_gear_sim.diagnosis.consistency import FORCE_FLOOR_N, Relation
+from landing_gear_sim.diagnosis.equations.flywheel import flywheel_reads as carries
+from landing_gear_sim.diagnosis.equations.load_cell import FORCE_FLOOR_N
 from landing_gear_sim.diagnosis.families.base import (
     DECIMATE,
     Evidence,
@@ -27,7 +28,7 @@ from landing_gear_sim.diagnosis.families.base import (
     Proposal,
     term_candidate,
 )
-from landing_gear_sim.diagnosis.flywheel_reads import flywheel_reads as carries
+from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.diagnosis.sparse import sparse_coefficients
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters

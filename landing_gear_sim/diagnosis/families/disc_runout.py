@@ -16,7 +16,7 @@ import numpy as np
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.wheel_angle import BRAKE_RUNOUT_KEYS, brake_ripple
 from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, WHEEL, Candidate
-from landing_gear_sim.diagnosis.consistency import BRAKE_RUNOUT_FLOOR, Relation
+from landing_gear_sim.diagnosis.equations.wheel import BRAKE_RUNOUT_FLOOR
 from landing_gear_sim.diagnosis.families.base import (
     Evidence,
     Family,
@@ -25,6 +25,7 @@ from landing_gear_sim.diagnosis.families.base import (
     term_candidate,
 )
 from landing_gear_sim.diagnosis.families.encoder_ripple import waves
+from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import display

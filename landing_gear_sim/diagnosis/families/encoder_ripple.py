@@ -16,7 +16,7 @@ import scipy.linalg
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.wheel_angle import ORDERS, TREND, ripple_design
 from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, Candidate
-from landing_gear_sim.diagnosis.consistency import RUNOUT_FLOOR, Relation
+from landing_gear_sim.diagnosis.equations.wheel_channel import RUNOUT_FLOOR
 from landing_gear_sim.diagnosis.families.base import (
     Evidence,
     Family,
@@ -24,6 +24,7 @@ from landing_gear_sim.diagnosis.families.base import (
     Proposal,
     term_candidate,
 )
+from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.diagnosis.sparse import sparse_coefficients
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters

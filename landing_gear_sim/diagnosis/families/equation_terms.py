@@ -1,7 +1,7 @@
 """``wheel``, ``flywheel`` and ``loading device``: terms no named family holds, in the rig's
 own equations (issue 29).
 
-Each family is one equation's generic slot (:mod:`~..equation_library`): called for by the
+Each family is one equation's generic slot (:mod:`~..equations`): called for by the
 equation's relation (its error needs a term of its library), it proposes the terms the
 error's sparse regression keeps, started at their fit, fitted with the parameters the
 calibration owns in the equation, and scored like any candidate. The finding is
@@ -19,7 +19,6 @@ import numpy as np
 
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import RunKind, Selector
-from landing_gear_sim.diagnosis import equation_library as eq
 from landing_gear_sim.diagnosis.catalogue import (
     BRAKE_RUNS,
     FRICTION,
@@ -28,6 +27,8 @@ from landing_gear_sim.diagnosis.catalogue import (
     WHEEL,
     Candidate,
 )
+from landing_gear_sim.diagnosis.equations import registry as eq
+from landing_gear_sim.diagnosis.equations.flywheel import flywheel_reads
 from landing_gear_sim.diagnosis.families.base import (
     Evidence,
     Family,
@@ -35,7 +36,6 @@ from landing_gear_sim.diagnosis.families.base import (
     Proposal,
     term_candidate,
 )
-from landing_gear_sim.diagnosis.flywheel_reads import flywheel_reads
 from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.diagnosis.selection import Selected
 from landing_gear_sim.model import basis

@@ -17,7 +17,6 @@ import numpy as np
 
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
-from landing_gear_sim.diagnosis.consistency import Relation
 from landing_gear_sim.diagnosis.families.base import (
     DECIMATE,
     Evidence,
@@ -26,6 +25,7 @@ from landing_gear_sim.diagnosis.families.base import (
     Proposal,
     term_candidate,
 )
+from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.diagnosis.sparse import sparse_coefficients
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters

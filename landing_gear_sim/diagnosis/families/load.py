@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
+from landing_gear_sim.diagnosis.equations.wheel import LOAD_UNIT_N
 from landing_gear_sim.diagnosis.families.base import (
     Evidence,
     Family,
@@ -17,7 +18,6 @@ from landing_gear_sim.diagnosis.families.base import (
     Proposal,
     term_candidate,
 )
-from landing_gear_sim.diagnosis.load_relation import LOAD_UNIT_N
 from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters

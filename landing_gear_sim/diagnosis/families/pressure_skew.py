@@ -20,7 +20,6 @@ from landing_gear_sim.diagnosis.catalogue import (
     WHEEL,
     Candidate,
 )
-from landing_gear_sim.diagnosis.consistency import Relation
 from landing_gear_sim.diagnosis.families.base import (
     Evidence,
     Family,
@@ -28,6 +27,7 @@ from landing_gear_sim.diagnosis.families.base import (
     Proposal,
     term_candidate,
 )
+from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import display

@@ -8,7 +8,6 @@ the relation "brake gain constant from run to run".
 from __future__ import annotations
 
 from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
-from landing_gear_sim.diagnosis.consistency import Relation
 from landing_gear_sim.diagnosis.families.base import (
     Evidence,
     Family,
@@ -16,6 +15,7 @@ from landing_gear_sim.diagnosis.families.base import (
     Proposal,
     term_candidate,
 )
+from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.units import display, signed

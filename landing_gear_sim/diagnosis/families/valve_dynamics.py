@@ -1,7 +1,7 @@
 """``valve`` dynamics: a term in A(s)'s generic slot (issue 41) — a valve stiffer at
 pressure, a spool's friction, a release unlike the apply.
 
-Called for by "valve follows A(s) between its levels" (:mod:`~..valve_library`), fitted
+Called for by "valve follows A(s) between its levels" (:mod:`~..equations.valve`), fitted
 with ω_n, ζ and the static map on the actuator runs, held out on the braking runs'
 pressure: a law of the valve must predict the pressure the brake was given.
 """
@@ -15,10 +15,10 @@ from landing_gear_sim.diagnosis.catalogue import (
     PRESSURE,
     STATIC_MAP,
 )
+from landing_gear_sim.diagnosis.equations.valve import VALVE_DYNAMICS
 from landing_gear_sim.diagnosis.families.base import Hidden
 from landing_gear_sim.diagnosis.families.equation_terms import TOLERANCE, EquationTerms
 from landing_gear_sim.diagnosis.relations import Relation
-from landing_gear_sim.diagnosis.valve_library import VALVE_DYNAMICS
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
 

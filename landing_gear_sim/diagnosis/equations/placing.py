@@ -1,17 +1,16 @@
-"""The rig's equations, each with its error from the measured signals: where a residual
-structure lives (issue 28, "say where").
+"""Where a residual structure lives (issue 28, "say where").
 
 A simulation's wheel-speed residual carries every equation's error: the valve's, the wheel's
 torque balance, the flywheel's momentum balance, the loading device's. Each equation's own
 error is computed here from the measured signals under the model (the other equations' terms
-measured, not simulated), so a structure found in a simulation's residual can be traced to
-the equation that carries it most strongly against its own noise — an `unexplained` finding
-names that equation, not a generic wheel-speed lead. No plotting here.
+measured, not simulated), each through its owner, so a structure found in a simulation's
+residual can be traced to the equation that carries it most strongly against its own noise —
+an `unexplained` finding names that equation, not a generic wheel-speed lead. No plotting
+here.
 """
 
 from __future__ import annotations
 
-import enum
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -21,75 +20,11 @@ from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration import flywheel as fly
 from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
 from landing_gear_sim.diagnosis import residuals as rs
+from landing_gear_sim.diagnosis.equations.equation import Equation
+from landing_gear_sim.diagnosis.equations.registry import DECLARED
 from landing_gear_sim.diagnosis.findings import Signature, SignatureKind
-from landing_gear_sim.diagnosis.relations import Relation
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.run import Run
-
-
-class Equation(str, enum.Enum):
-    """An equation of the rig's model, or a channel's measurement (compares equal to its
-    name); what each declares is in :data:`DECLARED`."""
-
-    VALVE = "valve"
-    WHEEL = "wheel"
-    TYRE = "tyre"
-    FLYWHEEL = "flywheel"
-    LOADING = "loading device"
-    FX_CHANNEL = "F_x channel"
-    PRESSURE_CHANNEL = "pressure channel"
-    WHEEL_CHANNEL = "wheel channel"
-    LOAD_CELL = "load cell"
-
-    def __str__(self) -> str:
-        return self.value
-
-    @property
-    def law(self) -> str:
-        """The equation, in words."""
-        return DECLARED[self].law
-
-
-@dataclass(frozen=True)
-class Declared:
-    """What an equation declares: its law in words, the measured channel its error shows in,
-    and the relations the rig measures twice that check it."""
-
-    law: str
-    channel: str
-    relations: tuple[Relation, ...]
-
-
-DECLARED: dict[Equation, Declared] = {
-    Equation.VALVE: Declared("P = A(s)·map(i) (valve pressure)", "pressure_pa", (
-        Relation.VALVE_DIRECTION, Relation.VALVE_MAP, Relation.VALVE_DYNAMICS)),
-    Equation.WHEEL: Declared("J_w·ω̇ = r·F_x − T_b (wheel rotation)", "longitudinal_force_n", (
-        Relation.GAIN_IN_SPEED, Relation.GAIN_IN_PRESSURE, Relation.RUN_DRIFT,
-        Relation.FRICTION_IN_LOAD, Relation.BRAKE_ANGLE, Relation.WHEEL_BALANCE)),
-    Equation.TYRE: Declared("F_x = F_z·μ(λ) (tyre force)", "wheel_speed_rad_s",
-                            (Relation.TYRE_LAW, Relation.LOCKED_SLIDING)),
-    Equation.FLYWHEEL: Declared("m_f·v̇ = −F_x − F_drag (flywheel)", "flywheel_speed_rad_s",
-                                (Relation.FLYWHEEL_BALANCE,)),
-    Equation.LOADING: Declared("F_z follows F_z0 − k_L·v² (loading device)", "vertical_load_n",
-                               (Relation.LOADING_LAW,)),
-    Equation.FX_CHANNEL: Declared("F_x,read = F_x (the load cell's F_x channel)",
-                                  "longitudinal_force_n",
-                                  (Relation.FREE_ROLLING, Relation.FX_CHANNEL)),
-    Equation.PRESSURE_CHANNEL: Declared("P_read = P (the pressure channel)", "pressure_pa",
-                                        (Relation.ZERO_CURRENT, Relation.PRESSURE_TIMING,
-                                         Relation.PRESSURE_READING)),
-    Equation.WHEEL_CHANNEL: Declared("ω_read = ω (the wheel's encoder)", "wheel_speed_rad_s",
-                                     (Relation.WHEEL_ANGLE,)),
-    Equation.LOAD_CELL: Declared("F_z,read = F_z (the load cell)", "vertical_load_n",
-                                 (Relation.NO_CONTACT,)),
-}
-"""Each equation's law, channel and relations: one place to add a relation (a relation
-checks the one equation that declares it)."""
-
-
-def declaring(relation: Relation) -> Equation:
-    """The equation that declares ``relation`` (a violation of it lives there)."""
-    return next(e for e, declared in DECLARED.items() if relation in declared.relations)
 
 
 @dataclass(frozen=True)
@@ -133,7 +68,7 @@ class Place:
     def describe(self) -> str:
         others = ", ".join(f"{e}: {s:.1f}" for e, s in self.strength.items()
                            if e is not self.equation)
-        return (f"it lives in the {self.equation.law} equation "
+        return (f"it lives in the {DECLARED[self.equation].law} equation "
                 f"({self.strength[self.equation]:.1f}; {others})")
 
 

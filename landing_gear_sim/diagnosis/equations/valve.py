@@ -1,5 +1,10 @@
-"""The valve's two equations with their libraries (issues 29, 41): its static map, read
-where A(s) has settled, and its dynamics A(s), read over the whole of an actuator run.
+"""The valve: its static map P_static = map(i) and its dynamics A(s), P = A(s)·P_static.
+
+Everything the diagnosis knows about the valve: the samples where it has settled
+(:func:`settled_valve`, the static map's and the pressure's relations read them), its
+relations (the same with the current rising and falling; settles on its quadratic map;
+follows A(s) between its levels), and its two libraries of terms: the static map's, read
+where A(s) has settled, and A(s)'s, read over the whole of an actuator run.
 
 A(s)'s generic slot (``actuator.term_*``, :mod:`landing_gear_sim.model.actuator`) adds
 Σ c_k φ_k(P, Ṗ, ΔP) to the pressure the valve is driven by, ΔP = μ P_static − P. Its error
@@ -7,21 +12,36 @@ is an output error (the measured pressure less the model's, through the pressure
 a term enters it as the model pressure's change per unit of its coefficient, the run
 simulated with the term tried (the plant's own step), beside the sensitivities to the
 parameters the calibration owns there (ω_n, ζ, the map, the delay), taken alike.
+
+The relation "valve the same with the current rising and falling" (:func:`valve_direction`)
+and the static map's library read the same samples: there the
+valve's dynamics A(s) have settled, and what the model's pressure misses is its static map.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
+import scipy.signal
 
-from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.calibration.runs import ClassifiedRun, RunKind
 from landing_gear_sim.calibration.slots import Slot, map_signals, seen
+from landing_gear_sim.calibration.statistics import (
+    effective_count,
+)
 from landing_gear_sim.diagnosis.catalogue import ACTUATOR, STATIC_MAP
-from landing_gear_sim.diagnosis.equations import Equation
+from landing_gear_sim.diagnosis.equations.equation import Declared, Equation
 from landing_gear_sim.diagnosis.library import Campaign, Library
-from landing_gear_sim.diagnosis.relations import Z_VIOLATED, Relation
+from landing_gear_sim.diagnosis.relations import (
+    MIN_CHECK_S,
+    MIN_SAMPLES,
+    Z_VIOLATED,
+    Check,
+    Relation,
+)
 from landing_gear_sim.diagnosis.selection import (
     Rows,
     Selected,
@@ -31,17 +51,95 @@ from landing_gear_sim.diagnosis.selection import (
     term_columns,
     variable,
 )
-from landing_gear_sim.diagnosis.settled_valve import Settled, settled_valve
 from landing_gear_sim.diagnosis.terms import Shaped
 from landing_gear_sim.errors import ParameterError
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
-from landing_gear_sim.model.actuator import actuator_matrices, settled_states
+from landing_gear_sim.model.actuator import actuator_matrices, actuator_pressure, settled_states
 from landing_gear_sim.model.parameters import INDEX, RigParameters
-from landing_gear_sim.model.scenario import current_noise_a, logged_to_held
+from landing_gear_sim.model.scenario import (
+    NOISY_CURRENT_A,
+    current_noise_a,
+    logged_to_held,
+)
 from landing_gear_sim.model.sensors import SensorModel
-from msg_tools.units import display
+from msg_tools.units import PA_PER_BAR, display
+
+PRESSURE_FLOOR_PA = 0.2 * PA_PER_BAR
+SETTLED_S = 0.3  # after a current change the valve has settled
+SLOW_A_S = 0.5  # slower current changes: A(s) errors leave no direction-locked residual
+RATE_WINDOW_S = 0.3  # a noisy current's rate of change is its slope over this ...
+RATE_NOISE_Z = 5.0  # ... and counted beyond this many σ of that average's noise
+NOISE_WINDOW_S = 0.5  # a current log's noise is read in pieces this long ...
+NOISE_QUANTILE = 0.2  # ... as this quantile of the pieces' estimates
+
+
+@dataclass(frozen=True)
+class Settled:
+    """An actuator run under a model, (n,) arrays: the current the valve was fed [A], the
+    model's pressure [Pa] and the measured one's excess over it as its channel reads it
+    [Pa], which way the current last moved (±1, 0: not yet), and the settled samples
+    (mask); the run's rate [Hz] and the time since its first sample [s]."""
+
+    current_a: np.ndarray
+    model_pa: np.ndarray
+    residual_pa: np.ndarray
+    direction: np.ndarray
+    settled: np.ndarray
+    rate_hz: float
+    time_s: np.ndarray
+
+
+def settled_valve(run: ClassifiedRun, params: RigParameters) -> Settled | None:
+    """The run's settled samples under ``params`` (None: a run whose log cannot tell)."""
+    noise = _log_noise_a(run)
+    if _unreadable(run, noise):
+        return None
+    current = logged_to_held(run.command_a)
+    model = actuator_pressure(params, current, run.rate_hz)
+    residual = run.pressure_pa - SensorModel.of(params).pressure_channel(run.time_s, model)
+    change = _current_rate(run, noise)
+    last = np.maximum.accumulate(np.where(change != 0.0, np.arange(change.size), 0))
+    window = max(1, round(SETTLED_S * run.rate_hz))
+    fast = np.abs(change) > SLOW_A_S
+    slow = np.convolve(fast, np.ones(window), mode="full")[:fast.size] == 0
+    band = (model > 2 * PRESSURE_FLOOR_PA) & (model < 0.9 * params.number(
+        K.ACTUATOR_MAX_PRESSURE_PA))
+    # the samples the logger lost are a line drawn through them, not the valve
+    return Settled(current, model, residual, np.sign(change[last]), slow & band & run.compared,
+                   run.rate_hz, run.time_s - run.time_s[0])
+
+
+def _unreadable(run: ClassifiedRun, noise_a: float) -> bool:
+    """A fast actuator run whose current log is noisy: fed the log (a sweep to 100 Hz keeps
+    it), a valve with play follows the noise both ways, and which way the current last
+    moved means nothing (the quasi-static ramp, fed its denoised command, still tells)."""
+    return run.kind is RunKind.ACTUATOR_DYNAMIC and noise_a > NOISY_CURRENT_A
+
+
+def _log_noise_a(run: ClassifiedRun) -> float:
+    """The current log's noise where the command is quietest [A]: a low quantile of the
+    estimate over NOISE_WINDOW_S pieces (a clean log's 100 Hz sweep read as 1.2 mA of
+    'noise' over the whole run, and the run went unchecked)."""
+    width = max(MIN_SAMPLES, round(NOISE_WINDOW_S * run.rate_hz))
+    pieces = [run.current_a[i:i + width] for i in range(0, run.current_a.size, width)]
+    return float(np.quantile([current_noise_a(p) for p in pieces], NOISE_QUANTILE))
+
+
+def _current_rate(run: ClassifiedRun, noise: float) -> np.ndarray:
+    """How fast the valve's current changes [A/s], (n,); 0 where it holds. A noisy log's
+    rate is the least-squares slope over RATE_WINDOW_S, counted only beyond RATE_NOISE_Z
+    times that slope's noise (10 mA of noise made every sample a 'fast change' on its own,
+    and the relation went unchecked)."""
+    if noise <= NOISY_CURRENT_A:
+        return np.diff(run.current_a, prepend=run.current_a[0]) * run.rate_hz
+    width = 2 * round(RATE_WINDOW_S * run.rate_hz / 2) + 1
+    slope = scipy.signal.savgol_filter(run.current_a, width, 1, deriv=1,
+                                       delta=1.0 / run.rate_hz, mode="nearest")
+    floor = RATE_NOISE_Z * noise * run.rate_hz * math.sqrt(12.0 / width ** 3)
+    return np.where(np.abs(slope) > floor, slope, 0.0)
+
 
 VALVE_RATE_HZ = 100.0  # a valve's samples are thinned to this: closer ones add little
 START_S = 0.5  # an actuator run's first samples: the model starts settled, the rig may not
@@ -49,8 +147,6 @@ TURNED = 10.0  # a term that moves the pressure this many times its own size tur
 REFINE_STEPS = 3  # Gauss-Newton steps on the kept terms' values
 HALVINGS = 8  # a term tried too large for A(s) is tried again at half, at most this often
 STEP_FRACTION = 1e-4  # an owned parameter's finite-difference step, of its value
-
-
 MAP_TERMS = (Shaped((basis.VALVE_CURRENT,), (basis.CUBE, basis.SIGNED_ROOT))
              + Shaped((basis.VALVE_CURRENT,), (basis.IDENTITY,))
              * Shaped((basis.VALVE_CURRENT,), (basis.SIGNED_ROOT,)))
@@ -64,7 +160,7 @@ class ValveLibrary(Library[Settled]):
     """The valve's static map P = k1 e + k2 e² + Σ c_k φ_k(e), e = I − I0: a map that bends
     beyond the quadratic the calibration fits. Its error is the measured pressure's excess
     over the model's on an actuator run's settled samples
-    (:func:`~.settled_valve.settled_valve`), where A(s) has settled; the terms the
+    (:func:`settled_valve`), where A(s) has settled; the terms the
     calibration owns there are the map's (k1, k2, and the dead-band's shift: a constant)."""
 
     equation = Equation.VALVE
@@ -101,6 +197,7 @@ def _excess(valve: Settled, params: RigParameters) -> np.ndarray:
     """The map's variable e = I − I0 ≥ 0 [A] of the current the valve was fed."""
     return el.valve_excess(valve.current_a, params.number(K.ACTUATOR_MAX_CURRENT_A),
                            params.number(K.ACTUATOR_DEADBAND_CURRENT_A))
+
 
 VALVE_TERMS = (
     Shaped((basis.VALVE_ERROR,), (basis.SIGN, basis.SIGNED_SQUARE, basis.CUBE,
@@ -339,3 +436,25 @@ class ValveDynamicsLibrary(Library[ValveRun]):
 
 VALVE = ValveLibrary()
 VALVE_DYNAMICS = ValveDynamicsLibrary()
+
+
+def valve_direction(run: ClassifiedRun, params: RigParameters) -> Check | None:
+    """Measured minus model pressure where the current fell last, against where it rose
+    last (on the settled samples, :func:`settled_valve`): a static map
+    cannot tell the two apart, a valve with play can. Positive: more pressure on the way
+    down."""
+    valve = settled_valve(run, params)
+    if valve is None:
+        return None
+    falling, rising = (valve.residual_pa[valve.settled & (valve.direction == s)]
+                       for s in (-1.0, 1.0))
+    if min(falling.size, rising.size) < MIN_CHECK_S * run.rate_hz:
+        return None
+    std = math.sqrt(sum(float(np.var(r)) / effective_count(r - r.mean())
+                        for r in (falling, rising)))
+    return Check(Relation.VALVE_DIRECTION, run.name, "slow current changes",
+                 float(falling.mean() - rising.mean()), std, PRESSURE_FLOOR_PA, "Pa")
+
+
+DECLARED = Declared("P = A(s)·map(i) (valve pressure)", "pressure_pa", (
+    Relation.VALVE_DIRECTION, Relation.VALVE_MAP, Relation.VALVE_DYNAMICS))

@@ -1,0 +1,40 @@
+"""What an equation of the rig is: its name (:class:`Equation`) and what it declares
+(:class:`Declared`): its law in words, the measured channel its error shows in and the
+relations that check it. Each equation's module declares its own.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+from landing_gear_sim.diagnosis.relations import Relation
+
+
+class Equation(str, enum.Enum):
+    """An equation of the rig's model, or a channel's measurement (compares equal to its
+    name); what each declares is in its module's ``DECLARED``, gathered by
+    :data:`~.registry.DECLARED`."""
+
+    VALVE = "valve"
+    WHEEL = "wheel"
+    TYRE = "tyre"
+    FLYWHEEL = "flywheel"
+    LOADING = "loading device"
+    FX_CHANNEL = "F_x channel"
+    PRESSURE_CHANNEL = "pressure channel"
+    WHEEL_CHANNEL = "wheel channel"
+    LOAD_CELL = "load cell"
+
+    def __str__(self) -> str:
+        return self.value
+
+
+@dataclass(frozen=True)
+class Declared:
+    """What an equation declares: its law in words, the measured channel its error shows in,
+    and the relations the rig measures twice that check it."""
+
+    law: str
+    channel: str
+    relations: tuple[Relation, ...]

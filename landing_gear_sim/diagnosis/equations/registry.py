@@ -1,0 +1,73 @@
+"""The rig's equations, gathered: what each declares (:data:`DECLARED`, from its module), its
+libraries of terms in the order the diagnosis reads them (:data:`LIBRARIES`), and what
+follows from them for a campaign or a model (each library's relation, the laws a model's
+slots hold). Adding an equation: its module, and its lines here.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from landing_gear_sim.diagnosis.equations import (
+    flywheel,
+    fx_channel,
+    load_cell,
+    loading,
+    pressure_channel,
+    tyre,
+    valve,
+    wheel,
+    wheel_channel,
+)
+from landing_gear_sim.diagnosis.equations.equation import Declared, Equation
+from landing_gear_sim.diagnosis.equations.flywheel import FLYWHEEL
+from landing_gear_sim.diagnosis.equations.fx_channel import FX_CHANNEL
+from landing_gear_sim.diagnosis.equations.loading import LOADING
+from landing_gear_sim.diagnosis.equations.pressure_channel import PRESSURE_CHANNEL
+from landing_gear_sim.diagnosis.equations.tyre import LOCKED_TYRE, TYRE
+from landing_gear_sim.diagnosis.equations.valve import VALVE, VALVE_DYNAMICS
+from landing_gear_sim.diagnosis.equations.wheel import WHEEL
+from landing_gear_sim.diagnosis.library import Campaign, Library
+from landing_gear_sim.diagnosis.relations import Check, Relation
+from landing_gear_sim.model.parameters import RigParameters
+
+DECLARED: dict[Equation, Declared] = {
+    Equation.VALVE: valve.DECLARED, Equation.WHEEL: wheel.DECLARED, Equation.TYRE: tyre.DECLARED,
+    Equation.FLYWHEEL: flywheel.DECLARED, Equation.LOADING: loading.DECLARED,
+    Equation.FX_CHANNEL: fx_channel.DECLARED,
+    Equation.PRESSURE_CHANNEL: pressure_channel.DECLARED,
+    Equation.WHEEL_CHANNEL: wheel_channel.DECLARED, Equation.LOAD_CELL: load_cell.DECLARED,
+}
+"""Each equation's law, channel and relations, as its module declares them (a relation
+checks the one equation that declares it)."""
+
+
+def declaring(relation: Relation) -> Equation:
+    """The equation that declares ``relation`` (a violation of it lives there)."""
+    return next(e for e, declared in DECLARED.items() if relation in declared.relations)
+
+
+LIBRARIES: tuple[Library[Any], ...] = (VALVE, VALVE_DYNAMICS, WHEEL, TYRE, FLYWHEEL, LOADING,
+                                       FX_CHANNEL, PRESSURE_CHANNEL)
+"""Every equation's library that checks its relation, in the order they are read (the
+tyre's locked library is not a check: its relation is the locked wheel's)."""
+__all__ = ["DECLARED", "FLYWHEEL", "FX_CHANNEL", "LIBRARIES", "LOADING", "LOCKED_TYRE",
+           "PRESSURE_CHANNEL", "TYRE", "VALVE", "VALVE_DYNAMICS", "WHEEL", "declaring",
+           "equation_checks", "held_laws", "held_notes"]
+
+
+def equation_checks(campaign: Campaign, params: RigParameters) -> list[Check]:
+    """Each library's relation over ``campaign`` under ``params``."""
+    return [c for lib in LIBRARIES if (c := lib.check(campaign, params)) is not None]
+
+
+def held_laws(params: RigParameters) -> list[str]:
+    """Each equation whose generic slot ``params`` fills, with its law written out ('the
+    wheel: J_w·ω̇ = r·F_x − T_b − 148 N m·[P > 0.5 bar]')."""
+    return [f"the {library.equation}: {law}" for library in LIBRARIES
+            if (law := library.held_law(params)) is not None]
+
+
+def held_notes(params: RigParameters) -> dict[str, str]:
+    """By key, what each filled place of every generic slot of ``params`` holds."""
+    return {key: note for library in LIBRARIES for key, note in library.held_notes(params).items()}

@@ -24,8 +24,8 @@ from landing_gear_sim.calibration.identify import MAX_SLIP_STIFFNESS, MAX_THETA1
 from landing_gear_sim.calibration.measured import run_static_load_n, simulate_run
 from landing_gear_sim.calibration.plausibility import unit_notes
 from landing_gear_sim.calibration.runs import (
-    Family,
     RunKind,
+    Setup,
     classified,
     classify,
     classify_all,
@@ -304,7 +304,7 @@ def _assert_as_clean(result, identified):
 
 def _direct_friction_fit(folder, params):
     """ϑ1..ϑ3 of the direct slip/μ fit (the refinement's start) on a folder's braking runs."""
-    runs = select(classify_all(read_campaign(folder).runs), [Family.BRAKE])
+    runs = select(classify_all(read_campaign(folder).runs), [Setup.BRAKE])
     return [e.value for e in fit_friction([prepare(r, params) for r in runs], params)]
 
 

@@ -34,8 +34,8 @@ from landing_gear_sim.calibration.friction import fit_friction, refine_friction
 from landing_gear_sim.calibration.plausibility import check_units, unit_notes
 from landing_gear_sim.calibration.runs import (
     ClassifiedRun,
-    Family,
     RunKind,
+    Setup,
     classify_all,
     fully_logged,
     select,
@@ -135,7 +135,7 @@ def _identify(runs: Sequence[Run], base: RigParameters, fix_theta3: bool,
     state.problems.extend(unit_notes(classified, base))
     ramps = select(classified, [RunKind.ACTUATOR_RAMP])
     dynamic = select(classified, [RunKind.ACTUATOR_DYNAMIC])
-    braking = select(classified, [Family.BRAKE])
+    braking = select(classified, [Setup.BRAKE])
 
     def dynamics() -> None:
         found, state.frf, notes = fit_actuator_dynamics(dynamic, state.params)

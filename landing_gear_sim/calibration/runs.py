@@ -53,8 +53,9 @@ UNIFORM_TOLERANCE = 1e-3  # of a period: steps closer than this count as evenly 
 SETTLE_AFTER_GAP_S = 0.2
 
 
-class Family(enum.Enum):
-    """Wheel off the flywheel (actuator-only test) or on it (braking test)."""
+class Setup(enum.Enum):
+    """How the rig is set up for a run: the wheel off the flywheel (an actuator-only test)
+    or on it (a braking test)."""
 
     ACTUATOR = "actuator"
     BRAKE = "brake"
@@ -75,29 +76,29 @@ class RunKind(str, enum.Enum):
         return self.value
 
     @property
-    def family(self) -> Family:
-        return _FAMILIES[self]
+    def setup(self) -> Setup:
+        return _SETUPS[self]
 
     @property
     def braking(self) -> bool:
         """The wheel is on the flywheel: speeds, loads and forces carry information."""
-        return self.family is Family.BRAKE
+        return self.setup is Setup.BRAKE
 
 
-_FAMILIES = {RunKind.ACTUATOR_RAMP: Family.ACTUATOR, RunKind.ACTUATOR_DYNAMIC: Family.ACTUATOR,
-             RunKind.BRAKE_CONSTANT: Family.BRAKE, RunKind.BRAKE_OSCILLATING: Family.BRAKE}
+_SETUPS = {RunKind.ACTUATOR_RAMP: Setup.ACTUATOR, RunKind.ACTUATOR_DYNAMIC: Setup.ACTUATOR,
+           RunKind.BRAKE_CONSTANT: Setup.BRAKE, RunKind.BRAKE_OSCILLATING: Setup.BRAKE}
 
-Selector = RunKind | Family
-"""A run kind, or a whole family of kinds."""
+Selector = RunKind | Setup
+"""A run kind, or every kind of a setup."""
 
 
-def family_of(selector: Selector) -> Family:
-    return selector.family if isinstance(selector, RunKind) else selector
+def setup_of(selector: Selector) -> Setup:
+    return selector.setup if isinstance(selector, RunKind) else selector
 
 
 def matches(kind: RunKind, selectors: Iterable[Selector]) -> bool:
-    """Whether ``kind`` is one of ``selectors`` (kinds or families)."""
-    return any(kind is s or kind.family is s for s in selectors)
+    """Whether ``kind`` is one of ``selectors`` (kinds or setups)."""
+    return any(kind is s or kind.setup is s for s in selectors)
 
 
 @dataclass(frozen=True)
@@ -222,7 +223,7 @@ def fully_logged(runs: Sequence[RunT], analysis: str) -> tuple[list[RunT], list[
 
 
 def select(runs: Sequence[ClassifiedRun], selectors: Iterable[Selector]) -> list[ClassifiedRun]:
-    """The runs of one of ``selectors`` (kinds or families), in order."""
+    """The runs of one of ``selectors`` (kinds or setups), in order."""
     chosen = tuple(selectors)
     return [r for r in runs if matches(r.kind, chosen)]
 

@@ -19,8 +19,8 @@ from landing_gear_sim.calibration.friction import friction_samples
 from landing_gear_sim.calibration.measured import channels_of, simulate_run
 from landing_gear_sim.calibration.plausibility import check_units
 from landing_gear_sim.calibration.runs import (
-    Family,
     RunKind,
+    Setup,
     classified,
     classify_all,
     select,
@@ -134,7 +134,7 @@ def validate_campaign(runs: Sequence[Run], params: RigParameters) -> Validation:
     """:func:`validate`, with the friction points and the actuator FRFs of the campaign."""
     classified_runs = classify_all(runs)
     check_units(classified_runs, params)  # a pressure in MPa had scored −600,000 %
-    braking = select(classified_runs, [Family.BRAKE])
+    braking = select(classified_runs, [Setup.BRAKE])
     dynamic = select(classified_runs, [RunKind.ACTUATOR_DYNAMIC])
     points = (friction_samples([br.prepare(r, params) for r in braking], params)
               if braking else None)

@@ -21,9 +21,9 @@ from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.differences import Objective
 from landing_gear_sim.calibration.runs import (
     ClassifiedRun,
-    Family,
     RunKind,
     Selector,
+    Setup,
     classify_all,
     select,
 )
@@ -129,8 +129,8 @@ GEAR_WALK = (K.GEAR_WALK_STIFFNESS_N_M_PER_RAD, K.GEAR_WALK_DAMPING_N_M_S_PER_RA
 PRESSURE = ("pressure_pa",)
 WHEEL = ("wheel_speed_rad_s", "longitudinal_force_n")
 FADE = (K.BRAKE_FADE_FRACTION, K.BRAKE_FADE_ENERGY_J)
-ACTUATOR_RUNS: tuple[Selector, ...] = (Family.ACTUATOR,)
-BRAKE_RUNS: tuple[Selector, ...] = (Family.BRAKE,)
+ACTUATOR_RUNS: tuple[Selector, ...] = (Setup.ACTUATOR,)
+BRAKE_RUNS: tuple[Selector, ...] = (Setup.BRAKE,)
 
 CATALOGUE: dict[str, Candidate] = {c.cause: c for c in (
     # an actuator effect shows in every run's pressure: fitted on the actuator runs,

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from landing_gear_sim.calibration.runs import ClassifiedRun, Family, RunKind, Selector, select
+from landing_gear_sim.calibration.runs import ClassifiedRun, RunKind, Selector, Setup, select
 from landing_gear_sim.diagnosis.catalogue import Candidate
 
 Need = tuple[Selector, str, str]
@@ -30,15 +30,15 @@ REQUIRED: dict[str, Need] = {
                                "offset trades with the uncalibrated map"),
 }
 """Causes that need a run kind beyond their family."""
-BRAKING_NEED: Need = (Family.BRAKE, "braking run", "the wheel's signals")
-ACTUATOR_NEED: Need = (Family.ACTUATOR, "actuator-only run", "the valve alone")
+BRAKING_NEED: Need = (Setup.BRAKE, "braking run", "the wheel's signals")
+ACTUATOR_NEED: Need = (Setup.ACTUATOR, "actuator-only run", "the valve alone")
 
 
 def required_runs(candidate: Candidate) -> Need:
     """The runs ``candidate`` cannot be identified without."""
     if candidate.cause in REQUIRED:
         return REQUIRED[candidate.cause]
-    return ACTUATOR_NEED if Family.ACTUATOR in candidate.runs else BRAKING_NEED
+    return ACTUATOR_NEED if Setup.ACTUATOR in candidate.runs else BRAKING_NEED
 
 
 def untestable(candidate: Candidate, runs: Sequence[ClassifiedRun]) -> str:

@@ -25,8 +25,8 @@ from landing_gear_sim.calibration.runs import (
     ClassifiedRun,
     RunKind,
     classify_all,
-    family_of,
     select,
+    setup_of,
 )
 from landing_gear_sim.calibration.statistics import effective_count
 from landing_gear_sim.diagnosis.catalogue import (
@@ -109,7 +109,7 @@ def split_runs(candidate: Candidate, runs: Sequence[Run]
     """
     classified = classify_all(runs)
     own = select(classified, candidate.runs) or select(
-        classified, [family_of(kind) for kind in candidate.runs])
+        classified, [setup_of(kind) for kind in candidate.runs])
     others = select(classified, candidate.held_out)
     if own and others:
         return own, others
@@ -408,10 +408,10 @@ def _at_bound(candidate: Candidate, fit: CandidateFit) -> bool:
 
 
 def _as_fitting(candidate: Candidate, runs: Sequence[ClassifiedRun]) -> Candidate:
-    """The candidate fitted on the families of ``runs`` (its own kinds, or when the
+    """The candidate fitted on the setups of ``runs`` (its own kinds, or when the
     campaign has none of those, the kinds it is otherwise checked on)."""
-    families = tuple(sorted({r.kind.family for r in runs}, key=lambda f: f.value))
-    return replace(candidate, runs=families)
+    setups = tuple(sorted({r.kind.setup for r in runs}, key=lambda f: f.value))
+    return replace(candidate, runs=setups)
 
 
 def key_std(candidate: Candidate, fit: CandidateFit) -> dict[str, float]:

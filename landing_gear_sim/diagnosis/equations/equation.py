@@ -6,9 +6,16 @@ relations that check it. Each equation's module declares its own.
 from __future__ import annotations
 
 import enum
+from collections.abc import Callable
 from dataclasses import dataclass
 
+import numpy as np
+
+from landing_gear_sim.calibration.braking import Braking
+from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.diagnosis.relations import Relation
+from landing_gear_sim.model.parameters import RigParameters
+from msg_tools.run import Run
 
 
 class Equation(str, enum.Enum):
@@ -28,6 +35,11 @@ class Equation(str, enum.Enum):
 
     def __str__(self) -> str:
         return self.value
+
+
+ErrorOf = Callable[[ClassifiedRun, Braking, RigParameters, Run], np.ndarray]
+"""An equation's error at every sample of a braking run under a model, from the run, its
+filtered signals, the model and the run simulated with it, (n,) in its unit."""
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,7 @@ import numpy as np
 
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration import flywheel as fly
+from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.slots import Slot, seen
 from landing_gear_sim.diagnosis.equations.equation import Declared, Equation
 from landing_gear_sim.diagnosis.library import (
@@ -34,6 +35,10 @@ from landing_gear_sim.model import basis
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
+from msg_tools.run import Run
+
+LAW = "m_f·v̇ = −F_x − α_d·v²"
+"""The flywheel's law, as its words and its written terms read it."""
 
 FLYWHEEL_TERMS = (Shaped((basis.SPEED,), (basis.SIGN, basis.IDENTITY, basis.CUBE))
                   + Shaped((basis.SPEED,), (basis.SIGN, basis.IDENTITY))
@@ -76,7 +81,7 @@ class FlywheelLibrary(BrakingLibrary):
                                np.column_stack(owned)[index], float(np.std(impulse[index])))
 
     def law(self, written: str, params: RigParameters) -> str:
-        return f"m_f·v̇ = −F_x − α_d·v² {written}"
+        return f"{LAW} {written}"
 
 
 FLYWHEEL = FlywheelLibrary()
@@ -108,5 +113,11 @@ def flywheel_reads(braking: Sequence[br.Braking], params: RigParameters,
     return carried * coefficient > 0 and abs(carried) >= abs(coefficient) / 2
 
 
-DECLARED = Declared("m_f·v̇ = −F_x − F_drag (flywheel)", "flywheel_speed_rad_s",
+def error(run: ClassifiedRun, b: br.Braking, params: RigParameters, simulated: Run
+          ) -> np.ndarray:
+    """The flywheel's error: its balance's m_f v̇ + F_x + F_r [N]."""
+    return fly.balance_error(b, params)
+
+
+DECLARED = Declared(f"{LAW} (flywheel)", "flywheel_speed_rad_s",
                     (Relation.FLYWHEEL_BALANCE,))

@@ -38,6 +38,9 @@ from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.units import signed
 
+LAW = "F_x,read = F_x"
+"""The fx channel's law, as its words and its written terms read it."""
+
 FX_TERMS = (Shaped((basis.RUN_TIME,), (basis.IDENTITY, basis.SQUARE, basis.SIGNED_ROOT))
             + Shaped((basis.LOAD,), (basis.SIGNED_SQUARE,))
             + Shaped((basis.RUN_TIME,), (basis.IDENTITY,)) * Shaped((basis.LOAD,),
@@ -100,7 +103,7 @@ class FxChannelLibrary(Library[tuple[ClassifiedRun, "br.Braking | None"]]):
     def law(self, written: str, params: RigParameters) -> str:
         crosstalk = params.number(K.SENSORS_CROSSTALK_FX_PER_FZ)
         shown = f" {signed(crosstalk, spec='.4g')}·F_z" if crosstalk else ""
-        return f"F_x,read = F_x{shown} {written}"
+        return f"{LAW}{shown} {written}"
 
 
 BALANCE_WINDOW_S = 1.0  # the flywheel's speed noise over m_f·Δv falls with the window
@@ -149,5 +152,7 @@ def free_rolling_force(b: br.Braking, params: RigParameters) -> Check | None:
 
 
 FX_CHANNEL = FxChannelLibrary()
-DECLARED = Declared("F_x,read = F_x (the load cell's F_x channel)",
+
+
+DECLARED = Declared(f"{LAW} (the load cell's F_x channel)",
                     "longitudinal_force_n", (Relation.FREE_ROLLING, Relation.FX_CHANNEL))

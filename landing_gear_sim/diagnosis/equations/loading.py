@@ -15,6 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from landing_gear_sim.calibration import braking as br
+from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.slots import Slot, seen
 from landing_gear_sim.diagnosis.equations.equation import Declared, Equation
 from landing_gear_sim.diagnosis.library import (
@@ -31,6 +32,7 @@ from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import (
     load_taken_at,
 )
+from msg_tools.run import Run
 from msg_tools.units import display
 
 SETTLE_S = 0.5  # after the touch-down ramp, before the loading device's load is its law
@@ -88,5 +90,13 @@ class LoadingLibrary(BrakingLibrary):
 
 
 LOADING = LoadingLibrary()
+
+
+def error(run: ClassifiedRun, b: br.Braking, params: RigParameters, simulated: Run
+          ) -> np.ndarray:
+    """The loading device's output error: the measured vertical load less the model's [N]."""
+    return run.vertical_load_n - simulated.vertical_load_n
+
+
 DECLARED = Declared("F_z follows F_z0 − k_L·v² (loading device)", "vertical_load_n",
                     (Relation.LOADING_LAW,))

@@ -17,11 +17,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from landing_gear_sim.calibration import braking as br
-from landing_gear_sim.calibration import flywheel as fly
 from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
 from landing_gear_sim.diagnosis import residuals as rs
+from landing_gear_sim.diagnosis.equations import valve
 from landing_gear_sim.diagnosis.equations.equation import Equation
-from landing_gear_sim.diagnosis.equations.registry import DECLARED
+from landing_gear_sim.diagnosis.equations.registry import DECLARED, ERRORS
 from landing_gear_sim.diagnosis.findings import Signature, SignatureKind
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.run import Run
@@ -42,18 +42,13 @@ def equation_errors(run: ClassifiedRun, params: RigParameters, simulated: Run
     """Each equation's error in ``run`` under ``params`` (``simulated``: the run simulated
     with them), over the samples a residual signature looks at: the whole of an actuator
     run, the braking window of a stop."""
-    valve = run.pressure_pa - simulated.pressure_pa
     if not run.braking:
-        return [EquationError(Equation.VALVE, run.name, valve, run.rate_hz)]
+        return [EquationError(Equation.VALVE, run.name, valve.output_error(run, simulated),
+                              run.rate_hz)]
     window = braking_window(run, params)
     b = br.prepare(run, params)
-    torque, energy = br.torque_balance(b, params)
-    wheel = torque - br.model_torque(b, params, energy, np.arange(b.time_s.size))
-    flywheel = fly.balance_error(b, params)[window]
-    loading = run.vertical_load_n - simulated.vertical_load_n
-    return [EquationError(e, run.name, values, run.rate_hz) for e, values in (
-        (Equation.VALVE, valve[window]), (Equation.WHEEL, wheel[window]),
-        (Equation.FLYWHEEL, flywheel), (Equation.LOADING, loading[window]))]
+    return [EquationError(equation, run.name, error(run, b, params, simulated)[window],
+                          run.rate_hz) for equation, error in ERRORS.items()]
 
 
 @dataclass(frozen=True)

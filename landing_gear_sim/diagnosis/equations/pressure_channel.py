@@ -50,6 +50,9 @@ from landing_gear_sim.model.scenario import (
 )
 from landing_gear_sim.model.sensors import SensorModel
 
+LAW = "P_read = P"
+"""The pressure channel's law, as its words and its written terms read it."""
+
 MAX_BRAKING_SLIP = 0.15  # beyond, the torque balance's derivative error dominates
 TIMING_FLOOR_S = 1e-3  # a channel out of step by less than a millisecond does not matter
 PRESSURE_TERMS = (Shaped((basis.RUN_TIME,), (basis.IDENTITY, basis.SQUARE, basis.SIGNED_ROOT))
@@ -100,7 +103,7 @@ class PressureChannelLibrary(BrakingLibrary):
             else None
 
     def law(self, written: str, params: RigParameters) -> str:
-        return f"P_read = P {written}"
+        return f"{LAW} {written}"
 
 
 def valve_reads(campaign: Campaign, params: RigParameters, chosen: Sequence[Selected]
@@ -177,6 +180,6 @@ def pressure_timing(runs: Sequence[br.Braking], params: RigParameters) -> list[C
                   f"{MAX_BRAKING_SLIP:g}", lag, lag_std, TIMING_FLOOR_S, "s")]
 
 
-DECLARED = Declared("P_read = P (the pressure channel)", "pressure_pa",
+DECLARED = Declared(f"{LAW} (the pressure channel)", "pressure_pa",
                     (Relation.ZERO_CURRENT, Relation.PRESSURE_TIMING,
                      Relation.PRESSURE_READING))

@@ -19,7 +19,7 @@ from landing_gear_sim.diagnosis.equations import (
     wheel,
     wheel_channel,
 )
-from landing_gear_sim.diagnosis.equations.equation import Declared, Equation
+from landing_gear_sim.diagnosis.equations.equation import Declared, Equation, ErrorOf
 from landing_gear_sim.diagnosis.equations.flywheel import FLYWHEEL
 from landing_gear_sim.diagnosis.equations.fx_channel import FX_CHANNEL
 from landing_gear_sim.diagnosis.equations.loading import LOADING
@@ -40,6 +40,13 @@ DECLARED: dict[Equation, Declared] = {
 }
 """Each equation's law, channel and relations, as its module declares them (a relation
 checks the one equation that declares it)."""
+
+
+ERRORS: dict[Equation, ErrorOf] = {
+    Equation.VALVE: valve.error, Equation.WHEEL: wheel.error, Equation.FLYWHEEL: flywheel.error,
+    Equation.LOADING: loading.error}
+"""The equations whose error a braking run's measured signals give at every sample (each its
+module's ``error``), in the order :mod:`.placing` reads them."""
 
 
 def declaring(relation: Relation) -> Equation:

@@ -48,6 +48,9 @@ from landing_gear_sim.model.quantities import (
     tyre_friction_at,
 )
 
+LAW = "μ = μ_B(λ)·g(F_z)"
+"""The tyre's law, as its words and its written terms read it."""
+
 LOCKED_RAD_S = 0.5  # the wheel is locked below this (filtered, and raw all around)
 AROUND_S = 0.1  # ... the raw channel reads no more than that within this window
 NOISE_Z = 6.0  # ... or than this many times its own noise at the lock (an analogue channel)
@@ -146,7 +149,7 @@ class TyreLibrary(BrakingLibrary):
                     float(np.sqrt(np.mean((slope * factor * _slip_noise(b, index)) ** 2))))
 
     def law(self, written: str, params: RigParameters) -> str:
-        return f"μ = μ_B(λ)·g(F_z) {written}"
+        return f"{LAW} {written}"
 
 
 class LockedTyreLibrary(TyreLibrary):
@@ -209,6 +212,10 @@ def channel_noise(values: np.ndarray) -> float:
 
 
 TYRE = TyreLibrary()
+
+
 LOCKED_TYRE = LockedTyreLibrary()  # the tyre's slot read where the wheel locks; not a check
-DECLARED = Declared("F_x = F_z·μ(λ) (tyre force)", "wheel_speed_rad_s",
+
+
+DECLARED = Declared(f"{LAW} (tyre force)", "wheel_speed_rad_s",
                     (Relation.TYRE_LAW, Relation.LOCKED_SLIDING))

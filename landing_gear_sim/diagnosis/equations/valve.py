@@ -27,6 +27,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import scipy.signal
 
+from landing_gear_sim.calibration.braking import Braking
 from landing_gear_sim.calibration.runs import ClassifiedRun, RunKind
 from landing_gear_sim.calibration.slots import Slot, map_signals, seen
 from landing_gear_sim.calibration.statistics import (
@@ -64,6 +65,7 @@ from landing_gear_sim.model.scenario import (
     logged_to_held,
 )
 from landing_gear_sim.model.sensors import SensorModel
+from msg_tools.run import Run
 from msg_tools.units import PA_PER_BAR, display
 
 PRESSURE_FLOOR_PA = 0.2 * PA_PER_BAR
@@ -435,6 +437,8 @@ class ValveDynamicsLibrary(Library[ValveRun]):
 
 
 VALVE = ValveLibrary()
+
+
 VALVE_DYNAMICS = ValveDynamicsLibrary()
 
 
@@ -454,6 +458,17 @@ def valve_direction(run: ClassifiedRun, params: RigParameters) -> Check | None:
                         for r in (falling, rising)))
     return Check(Relation.VALVE_DIRECTION, run.name, "slow current changes",
                  float(falling.mean() - rising.mean()), std, PRESSURE_FLOOR_PA, "Pa")
+
+
+def output_error(run: ClassifiedRun, simulated: Run) -> np.ndarray:
+    """The valve's output error: the measured pressure less the model's [Pa]."""
+    return run.pressure_pa - simulated.pressure_pa
+
+
+def error(run: ClassifiedRun, b: Braking, params: RigParameters, simulated: Run
+          ) -> np.ndarray:
+    """The valve's error in a braking run: its output error [Pa]."""
+    return output_error(run, simulated)
 
 
 DECLARED = Declared("P = A(s)·map(i) (valve pressure)", "pressure_pa", (

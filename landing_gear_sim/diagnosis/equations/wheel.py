@@ -54,7 +54,11 @@ from landing_gear_sim.diagnosis.terms import Shaped
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
+from msg_tools.run import Run
 from msg_tools.units import PA_PER_BAR
+
+LAW = "J_w·ω̇ = r·F_x − T_b"
+"""The wheel's law, as its words and its written terms read it."""
 
 TREND_FLOOR = 0.05  # a brake gain changing by less than 5 % over the range does not matter
 MIN_RUNS_FOR_DRIFT = 3
@@ -255,10 +259,19 @@ class WheelLibrary(BrakingLibrary):
         return torque_rows(b, params, index, Slot.WHEEL, terms or self.terms)
 
     def law(self, written: str, params: RigParameters) -> str:
-        return f"J_w·ω̇ = r·F_x − T_b {written}"
+        return f"{LAW} {written}"
 
 
 WHEEL = WheelLibrary()
-DECLARED = Declared("J_w·ω̇ = r·F_x − T_b (wheel rotation)", "longitudinal_force_n", (
+
+
+def error(run: ClassifiedRun, b: br.Braking, params: RigParameters, simulated: Run
+          ) -> np.ndarray:
+    """The wheel's error: the brake torque its balance measures less the model's [N m]."""
+    torque, energy = br.torque_balance(b, params)
+    return torque - br.model_torque(b, params, energy, np.arange(b.time_s.size))
+
+
+DECLARED = Declared(f"{LAW} (wheel rotation)", "longitudinal_force_n", (
     Relation.GAIN_IN_SPEED, Relation.GAIN_IN_PRESSURE, Relation.RUN_DRIFT,
     Relation.FRICTION_IN_LOAD, Relation.BRAKE_ANGLE, Relation.WHEEL_BALANCE))

@@ -8,6 +8,7 @@ import re
 
 from landing_gear_sim.calibration.measured import CHANNELS
 from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
+from landing_gear_sim.diagnosis.families import REGISTRY
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.report.figures import DISPLAY_UNITS
 from msg_tools.units import display
@@ -27,17 +28,11 @@ CAUSE_WORDS: dict[str, str] = {
 }
 """Each catalogued cause, physically (a cause missing here reads as its name)."""
 
-FAMILY_WORDS: dict[str, str] = {
-    "input_history": "the valve's pressure depends on its past (a hysteresis)",
-    "channel_skew": "a channel's samples are stamped out of time with the others",
-    "wheel_angle": "something turns with the wheel, once per revolution",
-    "channel_crosstalk": "a load cell reads part of another force",
-    "sliding_speed": "the tyre's friction changes with its sliding speed",
-    "run_drift": "the brake changes from run to run (wear)",
-    "load": "the tyre's friction changes with its load",
-}
-"""Each family a ``discovered`` finding may name, physically; an equation's own family
-reads 'the <equation>'s law lacks a term the runs show'."""
+FAMILY_WORDS: dict[str, str] = {name: text for family in REGISTRY
+                                 for name, text in family.words.items()}
+"""Each family a ``discovered`` finding may name, physically, as its module says it
+(``Family.words``); an equation's own family reads 'the <equation>'s law lacks a term the
+runs show'."""
 
 
 def cause_words(finding: Finding) -> str:

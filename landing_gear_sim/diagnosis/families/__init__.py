@@ -9,7 +9,9 @@ generated campaign, so that the tests and the benchmark parametrise over :data:`
 The diagnosis tries them in this order (:func:`~..discovered.discover`): the valve and the
 channels first, since what they misread distorts every other relation, then the wheel's
 equation; last the equations' generic slots (:mod:`.equation_terms`), for what no named
-family holds. Adding a family: one module here, its slot in the model, its line below.
+family holds. Adding a family: one module here (its words included: the report reads
+them from the registry), its line below, and its row in docs/diagnosis.md; a slot the model
+lacks, in the model too.
 """
 
 from __future__ import annotations

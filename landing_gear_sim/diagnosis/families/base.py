@@ -114,6 +114,9 @@ class Family(abc.ABC):
     relations: ClassVar[tuple[Relation, ...]]
     hidden: ClassVar[tuple[Hidden, ...]]
     rank: ClassVar[int]
+    words: ClassVar[dict[str, str]] = {}
+    """Each family it reports, physically, as the verdict's sentence says it (none: an
+    equation's own family, 'the <equation>'s law lacks a term the runs show')."""
 
     @abc.abstractmethod
     def propose(self, evidence: Evidence) -> list[Proposal]:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -53,6 +54,8 @@ LIBRARY = (ChannelTerm(K.SENSORS_CROSSTALK_FX_PER_FZ, "F_z", lambda r: r.vertica
 class ChannelCrosstalk(Family):
     name = "channel_crosstalk"
     reports = "channel_crosstalk"
+    words: ClassVar[dict[str, str]] = {
+        "channel_crosstalk": "a load cell reads part of another force"}
     equation = "F_x channel"
     keys = tuple(t.key for t in LIBRARY)
     relations = (Relation.FREE_ROLLING,)

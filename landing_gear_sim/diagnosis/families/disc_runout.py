@@ -10,6 +10,7 @@ rig's 5 % run-out once gave 'unexplained', a 7.8 Hz line.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import ClassVar
 
 import numpy as np
 
@@ -36,6 +37,8 @@ BOUNDS = (0.0, 0.3)  # relative: a third of the torque at most
 class DiscRunout(Family):
     name = "disc_runout"
     reports = "wheel_angle"
+    words: ClassVar[dict[str, str]] = {
+        "wheel_angle": "something turns with the wheel, once per revolution"}
     equation = "wheel"
     keys = BRAKE_RUNOUT_KEYS[::2]
     relations = (Relation.BRAKE_ANGLE,)

@@ -9,6 +9,7 @@ regression in the angle domain, each run at its own phase.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import ClassVar
 
 import numpy as np
 import scipy.linalg
@@ -45,6 +46,8 @@ def _hide(rng: np.random.Generator, datasheet: RigParameters) -> dict[str, float
 class EncoderRipple(Family):
     name = "encoder_ripple"
     reports = "wheel_angle"
+    words: ClassVar[dict[str, str]] = {
+        "wheel_angle": "something turns with the wheel, once per revolution"}
     equation = "wheel channel"
     keys = RUNOUT_KEYS[::2]
     relations = (Relation.WHEEL_ANGLE,)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -59,6 +60,8 @@ LIBRARY = (
 class GainLaw(Family):
     name = "gain_law"
     reports = "sliding_speed"  # or pressure_level, or both: the kept terms name it
+    words: ClassVar[dict[str, str]] = {
+        "sliding_speed": "the tyre's friction changes with its sliding speed"}
     equation = "wheel"
     keys = tuple(t.key for t in LIBRARY)
     relations = (Relation.GAIN_IN_SPEED, Relation.GAIN_IN_PRESSURE)

@@ -7,6 +7,8 @@ way down it holds more pressure than on the way up, ≈ k1·w: called for by the
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 from landing_gear_sim.diagnosis.catalogue import (
     ACTUATOR_RUNS,
     BRAKE_RUNS,
@@ -33,6 +35,8 @@ BOUNDS = (0.0, 0.2)  # A: a fifth of the valve's range
 class InputHistory(Family):
     name = "input_history"
     reports = "input_history"
+    words: ClassVar[dict[str, str]] = {
+        "input_history": "the valve's pressure depends on its past (a hysteresis)"}
     equation = "valve"
     keys = (KEY,)
     relations = (Relation.VALVE_DIRECTION,)

@@ -7,6 +7,8 @@ load", which only stops at two static loads can check (``campaign --light-runs``
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 
 from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
@@ -30,6 +32,8 @@ KEY = K.FRICTION_LOAD_SENSITIVITY_PER_N
 class Load(Family):
     name = "load"
     reports = "load"
+    words: ClassVar[dict[str, str]] = {
+        "load": "the tyre's friction changes with its load"}
     equation = "wheel"
     keys = (KEY,)
     relations = (Relation.FRICTION_IN_LOAD,)

@@ -9,6 +9,7 @@ its size with the wheel "leading" the extended model by as much.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import ClassVar
 
 from landing_gear_sim.calibration.identify import identify
 from landing_gear_sim.calibration.runs import ClassifiedRun
@@ -39,6 +40,8 @@ BOUNDS = (0.0, 0.1)  # s
 class PressureSkew(Family):
     name = "pressure_skew"
     reports = "channel_skew"
+    words: ClassVar[dict[str, str]] = {
+        "channel_skew": "a channel's samples are stamped out of time with the others"}
     equation = "pressure channel"
     keys = (KEY,)
     relations = (Relation.PRESSURE_TIMING,)

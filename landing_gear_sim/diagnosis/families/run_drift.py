@@ -7,6 +7,8 @@ the relation "brake gain constant from run to run".
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
 from landing_gear_sim.diagnosis.families.base import (
     Evidence,
@@ -27,6 +29,8 @@ BOUNDS = (-0.2, 0.2)  # per run: a fifth of k_b from one run to the next at most
 class RunDrift(Family):
     name = "run_drift"
     reports = "run_drift"
+    words: ClassVar[dict[str, str]] = {
+        "run_drift": "the brake changes from run to run (wear)"}
     equation = "wheel"
     keys = (KEY,)
     relations = (Relation.RUN_DRIFT,)

@@ -7,6 +7,7 @@ consistently over the runs (a residual signature; 20 ms once gave 'none').
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import ClassVar
 
 from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
 from landing_gear_sim.diagnosis.families.base import (
@@ -34,6 +35,8 @@ def wheel_lags(signatures: Sequence[Signature]) -> list[float]:
 class WheelSkew(Family):
     name = "wheel_skew"
     reports = "channel_skew"
+    words: ClassVar[dict[str, str]] = {
+        "channel_skew": "a channel's samples are stamped out of time with the others"}
     equation = "wheel channel"
     keys = (KEY,)
     relations = ()

@@ -19,6 +19,7 @@ from landing_gear_sim.calibration import flywheel as fly
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.slots import Slot
 from landing_gear_sim.diagnosis.equations.equation import Declared, Equation
+from landing_gear_sim.diagnosis.equations.flywheel import flywheel_reads
 from landing_gear_sim.diagnosis.equations.load_cell import FORCE_FLOOR_N
 from landing_gear_sim.diagnosis.library import (
     Campaign,
@@ -29,7 +30,14 @@ from landing_gear_sim.diagnosis.relations import (
     Relation,
     mean_check,
 )
-from landing_gear_sim.diagnosis.selection import Rows, Term, basis_terms, term_columns
+from landing_gear_sim.diagnosis.selection import (
+    Fitted,
+    Rows,
+    Selected,
+    Term,
+    basis_terms,
+    term_columns,
+)
 from landing_gear_sim.diagnosis.terms import Shaped
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import elements as el
@@ -100,6 +108,16 @@ class FxChannelLibrary(Library[tuple[ClassifiedRun, "br.Braking | None"]]):
             return None
         return Rows(error, columns, owned, params.number(K.LOADING_STATIC_LOAD_N))
 
+    def _kept(self, campaign: Campaign, params: RigParameters, rows: list[Rows],
+              fitted: Fitted | None) -> list[Selected]:
+        """The kept terms the flywheel's momentum balance carries too
+        (:func:`flywheel_reads_term`): the flywheel feels the true F_x, the channel reads it
+        wrong; a torque on the wheel (a bearing's, pushed by the tyre) breaks the
+        free-rolling relation alike but leaves the flywheel's balance alone (U06's drift had
+        been named a wheel term)."""
+        return [s for s in super()._kept(campaign, params, rows, fitted)
+                if flywheel_reads_term(campaign.braking, params, s)]
+
     def law(self, written: str, params: RigParameters) -> str:
         crosstalk = params.number(K.SENSORS_CROSSTALK_FX_PER_FZ)
         shown = f" {signed(crosstalk, spec='.4g')}·F_z" if crosstalk else ""
@@ -156,3 +174,20 @@ FX_CHANNEL = FxChannelLibrary()
 
 DECLARED = Declared(f"{LAW} (the load cell's F_x channel)",
                     "longitudinal_force_n", (Relation.FREE_ROLLING, Relation.FX_CHANNEL))
+
+
+def flywheel_reads_term(braking: Sequence[br.Braking], params: RigParameters,
+                        selected: Selected) -> bool:
+    """Whether the flywheel's balance carries the channel's term ``selected`` too (at least
+    half of it, the same way)."""
+    code = selected.term.code
+    if code is None:
+        return False
+
+    def values(b: br.Braking) -> np.ndarray:
+        measured = np.zeros((b.time_s.size, basis.N_SIGNALS))
+        measured[:, basis.LOAD] = b.run.vertical_load_n
+        measured[:, basis.RUN_TIME] = br.run_time_s(b.run)
+        return basis.term_values(code, measured)
+
+    return flywheel_reads(braking, params, values, selected.value)

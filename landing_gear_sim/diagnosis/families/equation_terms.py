@@ -17,7 +17,6 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import RunKind, Selector
 from landing_gear_sim.diagnosis.catalogue import (
     BRAKE_RUNS,
@@ -28,7 +27,6 @@ from landing_gear_sim.diagnosis.catalogue import (
     Candidate,
 )
 from landing_gear_sim.diagnosis.equations import registry as eq
-from landing_gear_sim.diagnosis.equations.flywheel import flywheel_reads
 from landing_gear_sim.diagnosis.families.base import (
     Evidence,
     Family,
@@ -229,10 +227,8 @@ class ValveTerms(EquationTerms):
 
 class FxChannelTerms(EquationTerms):
     """The load cell's F_x channel (rank 5, with the named crosstalk: the channels first,
-    since what they misread distorts every other relation). A term it keeps must show in
-    the flywheel's momentum balance too: the flywheel feels the true F_x, the channel reads
-    it wrong (a bearing's torque on the wheel, pushed by the tyre, breaks the free-rolling
-    relation alike; U06's drift had been named a wheel term)."""
+    since what they misread distorts every other relation). Its library keeps only the
+    terms the flywheel's momentum balance carries too."""
 
     name = "fx_channel_equation"
     library = eq.FX_CHANNEL
@@ -248,9 +244,8 @@ class FxChannelTerms(EquationTerms):
     def propose(self, evidence: Evidence) -> list[Proposal]:
         if not any(evidence.violated(r) for r in self.relations):
             return []
-        chosen = [s for s in self.library.select(evidence.campaign, evidence.model)
-                  if _flywheel_reads(evidence, s)]
-        return self._proposals(evidence, chosen)
+        return self._proposals(evidence, self.library.select(evidence.campaign,
+                                                             evidence.model))
 
 
 class PressureChannelTerms(EquationTerms):
@@ -276,22 +271,6 @@ class PressureChannelTerms(EquationTerms):
             return []
         chosen = self.library.select(evidence.campaign, evidence.model)  # the valve reads
         return self._proposals(evidence, chosen)
-
-
-def _flywheel_reads(evidence: Evidence, selected: Selected) -> bool:
-    """Whether the flywheel's balance carries the channel's term too (at least half of it,
-    the same way)."""
-    code = selected.term.code
-    if code is None:
-        return False
-
-    def values(b: br.Braking) -> np.ndarray:
-        measured = np.zeros((b.time_s.size, basis.N_SIGNALS))
-        measured[:, basis.LOAD] = b.run.vertical_load_n
-        measured[:, basis.RUN_TIME] = br.run_time_s(b.run)
-        return basis.term_values(code, measured)
-
-    return flywheel_reads(evidence.braking, evidence.model, values, selected.value)
 
 
 VALVE_FAMILY = ValveTerms()

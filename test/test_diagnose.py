@@ -648,7 +648,7 @@ def test_each_models_relations_are_checked_once_the_rounds_computing_them_as_the
     """The checks of the calibrated model (and of the final one) were computed after the
     rounds, in series, 1.6 s of I02's diagnosis; a round now computes its model's while
     its candidates fit, and what a round computed is not computed again."""
-    from landing_gear_sim.diagnosis import diagnose as d
+    from landing_gear_sim.diagnosis import rounds as d
 
     calls: list[object] = []
     monkeypatch.setattr(d, "check_campaign", lambda runs, model: calls.append(model) or [model])

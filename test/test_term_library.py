@@ -478,7 +478,7 @@ def test_the_diagnosis_contract_lists_each_generic_slots_library_as_composed():
     cells = [re.split(r"(?<!\\)\|", line) for line in page.splitlines()
              if line.startswith("| ")]
     rows = {c[1].strip(): "|".join(c) for c in cells if len(c) == 5}
-    labels = {eq.VALVE_DYNAMICS: "valve (A(s), `diagnosis/valve_library.py`)",
+    labels = {eq.VALVE_DYNAMICS: "valve (A(s), `diagnosis/equations/valve.py`)",
               eq.VALVE: "valve (static map)"}
     for library in (eq.WHEEL, eq.TYRE, eq.LOADING, eq.FX_CHANNEL, eq.VALVE_DYNAMICS,
                     eq.FLYWHEEL, eq.VALVE, eq.PRESSURE_CHANNEL):

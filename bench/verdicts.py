@@ -161,12 +161,15 @@ def main() -> int:
     parser.add_argument("--sets", default=",".join(SETS), help=f"of {', '.join(SETS)}")
     parser.add_argument("--only", default="", help="only campaigns whose key contains this")
     parser.add_argument("--campaigns", type=Path, default=Path("out/verdicts/campaigns"))
+    parser.add_argument("--output", type=Path,
+                        help="with --against: where the answers after go (default: beside the "
+                             "kept ones, *.after.json); a run started again resumes it")
     args = parser.parse_args()
     unknown = set(args.sets.split(",")) - set(SETS)
     if unknown:
         parser.error(f"--sets: unknown {', '.join(sorted(unknown))}")
     kept = json.loads(args.against.read_text(encoding="utf-8")) if args.against else {}
-    output = args.save or args.against.with_suffix(".after.json")
+    output = args.save or args.output or args.against.with_suffix(".after.json")
     done = json.loads(output.read_text(encoding="utf-8")) if output.is_file() else {}
     found = 0
     for campaign in plan(args.sets.split(","), args.campaigns):

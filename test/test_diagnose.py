@@ -9,11 +9,14 @@ import html
 import io
 import json
 import math
+import multiprocessing
 import re
 import signal
+import struct
 import subprocess
 import sys
 import time
+from concurrent.futures import ProcessPoolExecutor
 from html.parser import HTMLParser
 from pathlib import Path
 from types import SimpleNamespace
@@ -28,7 +31,7 @@ from landing_gear_sim.diagnosis.consistency import inconsistent
 from landing_gear_sim.diagnosis.diagnose import Diagnosis, diagnose
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.relations import Check, Relation
-from landing_gear_sim.diagnosis.rounds import tried_again
+from landing_gear_sim.diagnosis.rounds import stop_pool, tried_again
 from landing_gear_sim.diagnosis.scoring import split_runs
 from landing_gear_sim.errors import DiagnosisError
 from landing_gear_sim.model.parameters import load_parameters
@@ -681,3 +684,26 @@ def test_a_cause_short_of_the_evidence_beside_the_rounds_best_is_not_fitted_agai
     # just past the threshold: tried again
     assert [c.cause for c in tried_again([best, _scored("tire_relaxation", -10.5)], best)] == [
         "tire_relaxation"]
+
+
+def _cut_short_result(pool: ProcessPoolExecutor) -> None:
+    """Half of a result message in ``pool``'s result pipe, as a worker killed while it sends
+    one leaves it: the length of a 1000-byte message, then 10 bytes."""
+    pool.submit(int, 0).result()  # the manager thread runs, reading the pipe
+    writer = pool._result_queue._writer  # the pipe the workers write to
+    writer._send(struct.pack("!i", 1000) + b"0123456789")
+
+
+def test_a_worker_killed_mid_result_does_not_hang_the_exit():
+    """A SIGTERM'd `diagnose` was found alive 25 minutes on: its worker was terminated while
+    it sent a result, the executor's manager thread waited for the rest of the message, and
+    the interpreter's exit joins that thread. Ending the pool as a signal does leaves no
+    thread waiting."""
+    pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork"))
+    _cut_short_result(pool)
+    manager = pool._executor_manager_thread
+    time.sleep(0.2)
+    assert manager.is_alive()  # waiting for the rest of the message
+    stop_pool(pool)
+    manager.join(timeout=5)
+    assert not manager.is_alive()

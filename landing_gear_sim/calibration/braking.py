@@ -159,15 +159,23 @@ def torque_balance(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray
     reading of the wheel's balance from measured signals: the calibration's gain, the
     diagnosis's wheel error and library, the free rolling's F_x and the disc's run-out all
     read it."""
-    resisted, energy = wheel_resisted(b, p)
-    return rolling_radius_at(p, b.load) * b.force - resisted, energy
+    pushed, resisted, energy = _wheel_torques(b, p)
+    return pushed - resisted, energy
 
 
 def wheel_resisted(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray]:
     """What the wheel's balance takes off r F_x beside the brake, J_w ω̇ + T_extra [N m]
     (T_extra: the wheel's named slot and its generic slot of ``p``, 0 unless a diagnosis
-    found a term), and the energy the brake absorbed [J] (a term may read it: taken from the
-    torque without the generic slot)."""
+    found a term), and the energy the brake absorbed [J]."""
+    _, resisted, energy = _wheel_torques(b, p)
+    return resisted, energy
+
+
+def _wheel_torques(b: Braking, p: RigParameters
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The wheel's balance at each sample of ``b``: the torque the tyre pushes, r F_x, what
+    it takes off beside the brake, J_w ω̇ + T_extra [N m], and the energy the brake absorbed
+    [J] (a term of the generic slot may read it: taken from the torque without that slot)."""
     pushed = rolling_radius_at(p, b.load) * b.force
     resisted = p.number(K.WHEEL_INERTIA_KG_M2) * b.wheel_rate \
         + wheel_extra_torque(p.vector(), b.wheel)
@@ -175,7 +183,7 @@ def wheel_resisted(b: Braking, p: RigParameters) -> tuple[np.ndarray, np.ndarray
     if Slot.WHEEL.occupied(p):
         resisted = resisted + Slot.WHEEL.value_of(p, measured_signals(b, p, energy))
         energy = _absorbed(b, pushed - resisted)
-    return resisted, energy
+    return pushed, resisted, energy
 
 
 def _absorbed(b: Braking, torque: np.ndarray) -> np.ndarray:

@@ -263,15 +263,6 @@ def drag_force(p, speed_m_s):
 
 
 @njit(cache=True)
-def drag_forces(p, speed_m_s):
-    """:func:`drag_force` of each speed of an array (n,) [N]."""
-    out = np.empty(speed_m_s.shape[0])
-    for i in range(out.shape[0]):
-        out[i] = drag_force(p, speed_m_s[i])
-    return out
-
-
-@njit(cache=True)
 def flywheel_extra_force(p, speed_m_s):
     """The flywheel equation's named slot: F₀ sgn v + F₁ v, a force opposing the motion
     beside the drag (0 on the reference rig; floats or arrays)."""

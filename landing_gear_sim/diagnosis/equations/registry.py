@@ -1,11 +1,12 @@
 """The rig's equations, gathered: what each declares (:data:`DECLARED`, from its module), its
 libraries of terms in the order the diagnosis reads them (:data:`LIBRARIES`), and what
 follows from them for a campaign or a model (each library's relation, the laws a model's
-slots hold). Adding an equation: its module, and its lines here.
+slots hold). Adding an equation: its module, and its line in :data:`MODULES`.
 """
 
 from __future__ import annotations
 
+from types import ModuleType
 from typing import Any
 
 from landing_gear_sim.diagnosis.equations import (
@@ -31,20 +32,20 @@ from landing_gear_sim.diagnosis.library import Campaign, Library
 from landing_gear_sim.diagnosis.relations import Check, Relation
 from landing_gear_sim.model.parameters import RigParameters
 
-DECLARED: dict[Equation, Declared] = {
-    Equation.VALVE: valve.DECLARED, Equation.WHEEL: wheel.DECLARED, Equation.TYRE: tyre.DECLARED,
-    Equation.FLYWHEEL: flywheel.DECLARED, Equation.LOADING: loading.DECLARED,
-    Equation.FX_CHANNEL: fx_channel.DECLARED,
-    Equation.PRESSURE_CHANNEL: pressure_channel.DECLARED,
-    Equation.WHEEL_CHANNEL: wheel_channel.DECLARED, Equation.LOAD_CELL: load_cell.DECLARED,
+MODULES: dict[Equation, ModuleType] = {
+    Equation.VALVE: valve, Equation.WHEEL: wheel, Equation.TYRE: tyre,
+    Equation.FLYWHEEL: flywheel, Equation.LOADING: loading, Equation.FX_CHANNEL: fx_channel,
+    Equation.PRESSURE_CHANNEL: pressure_channel, Equation.WHEEL_CHANNEL: wheel_channel,
+    Equation.LOAD_CELL: load_cell,
 }
+"""Each equation's module: the one line to add with an equation's module."""
+
+DECLARED: dict[Equation, Declared] = {e: m.DECLARED for e, m in MODULES.items()}
 """Each equation's law, channel and relations, as its module declares them (a relation
 checks the one equation that declares it)."""
 
-
-ERRORS: dict[Equation, ErrorOf] = {
-    Equation.VALVE: valve.error, Equation.WHEEL: wheel.error, Equation.FLYWHEEL: flywheel.error,
-    Equation.LOADING: loading.error}
+ERRORS: dict[Equation, ErrorOf] = {e: m.error for e, m in MODULES.items()
+                                   if hasattr(m, "error")}
 """The equations whose error a braking run's measured signals give at every sample (each its
 module's ``error``), in the order :mod:`.placing` reads them."""
 
@@ -58,6 +59,7 @@ LIBRARIES: tuple[Library[Any], ...] = (VALVE, VALVE_DYNAMICS, WHEEL, TYRE, FLYWH
                                        FX_CHANNEL, PRESSURE_CHANNEL)
 """Every equation's library that checks its relation, in the order they are read (the
 tyre's locked library is not a check: its relation is the locked wheel's)."""
+
 __all__ = ["DECLARED", "FLYWHEEL", "FX_CHANNEL", "LIBRARIES", "LOADING", "LOCKED_TYRE",
            "PRESSURE_CHANNEL", "TYRE", "VALVE", "VALVE_DYNAMICS", "WHEEL", "declaring",
            "equation_checks", "held_laws", "held_notes"]

@@ -37,6 +37,7 @@ from landing_gear_sim.diagnosis.selection import (
     Term,
     basis_terms,
     term_columns,
+    variable,
 )
 from landing_gear_sim.diagnosis.terms import Shaped
 from landing_gear_sim.model import basis
@@ -116,7 +117,7 @@ class FxChannelLibrary(Library[tuple[ClassifiedRun, "br.Braking | None"]]):
         free-rolling relation alike but leaves the flywheel's balance alone (U06's drift had
         been named a wheel term)."""
         return [s for s in super()._kept(campaign, params, rows, fitted)
-                if flywheel_reads_term(campaign.braking, params, s)]
+                if flywheel_reads_term(campaign.braking, params, s.term, s.value)]
 
     def law(self, written: str, params: RigParameters) -> str:
         crosstalk = params.number(K.SENSORS_CROSSTALK_FX_PER_FZ)
@@ -177,17 +178,19 @@ DECLARED = Declared(f"{LAW} (the load cell's F_x channel)",
 
 
 def flywheel_reads_term(braking: Sequence[br.Braking], params: RigParameters,
-                        selected: Selected) -> bool:
-    """Whether the flywheel's balance carries the channel's term ``selected`` too (at least
-    half of it, the same way)."""
-    code = selected.term.code
-    if code is None:
-        return False
+                        term: Term[Any], value: float) -> bool:
+    """Whether the flywheel's balance carries ``value`` of the channel's ``term`` too (at
+    least half of it, the same way): the one rule for every term of the F_x channel, a
+    basis function of its generic slot or a named family's (a crosstalk's F_z, whose
+    ``values`` read a run)."""
+    code = term.code
 
     def values(b: br.Braking) -> np.ndarray:
+        if code is None:
+            return variable(term, b.run, params)
         measured = np.zeros((b.time_s.size, basis.N_SIGNALS))
         measured[:, basis.LOAD] = b.run.vertical_load_n
         measured[:, basis.RUN_TIME] = br.run_time_s(b.run)
         return basis.term_values(code, measured)
 
-    return flywheel_reads(braking, params, values, selected.value)
+    return flywheel_reads(braking, params, values, value)

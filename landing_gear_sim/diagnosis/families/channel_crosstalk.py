@@ -4,14 +4,14 @@ measurement equation (issue 14).
 Called for by the relation "free rolling ⇒ F_x = J_w ω̇ / r": what the F_x channel reads
 where the true F_x is known — before braking (the wheel's inertia force) and off the ground
 (0) — is regressed on the channel library by a sparse solver (BIC). A channel kept must
-show in the flywheel's momentum balance too (:func:`flywheel_reads`): a bearing's torque on
-the wheel breaks the free-rolling relation alike, and was once named a crosstalk.
+show in the flywheel's momentum balance too, the F_x channel's rule for every term of it
+(:func:`~..equations.fx_channel.flywheel_reads_term`): a bearing's torque on the wheel
+breaks the free-rolling relation alike, and was once named a crosstalk.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Sequence
 from typing import ClassVar
 
 import numpy as np
@@ -19,7 +19,7 @@ import numpy as np
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.diagnosis.catalogue import BRAKE_RUNS, FRICTION, WHEEL, Candidate
-from landing_gear_sim.diagnosis.equations.flywheel import flywheel_reads as carries
+from landing_gear_sim.diagnosis.equations.fx_channel import flywheel_reads_term
 from landing_gear_sim.diagnosis.equations.load_cell import FORCE_FLOOR_N
 from landing_gear_sim.diagnosis.families.base import (
     DECIMATE,
@@ -30,6 +30,7 @@ from landing_gear_sim.diagnosis.families.base import (
     term_candidate,
 )
 from landing_gear_sim.diagnosis.relations import Relation
+from landing_gear_sim.diagnosis.selection import Term, variable
 from landing_gear_sim.diagnosis.sparse import sparse_coefficients
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
@@ -38,17 +39,10 @@ from msg_tools.units import signed
 FRACTION_BOUND = 0.1  # of the other channel at most
 
 
-@dataclass(frozen=True)
-class ChannelTerm:
-    """Another measured channel the F_x channel may carry: its slot (a fraction), symbol
-    and values."""
-
-    key: str
-    symbol: str
-    values: Callable[[ClassifiedRun], np.ndarray]
-
-
-LIBRARY = (ChannelTerm(K.SENSORS_CROSSTALK_FX_PER_FZ, "F_z", lambda r: r.vertical_load_n),)
+LIBRARY: tuple[Term[ClassifiedRun], ...] = (
+    Term(K.SENSORS_CROSSTALK_FX_PER_FZ, "F_z", "-", FRACTION_BOUND,
+         lambda run, params: run.vertical_load_n),)
+"""The other channels the F_x channel may carry, each as a fraction of it."""
 
 
 class ChannelCrosstalk(Family):
@@ -73,7 +67,7 @@ class ChannelCrosstalk(Family):
             return []
         terms = {term: fraction for term, fraction in select_terms(
             evidence.runs, evidence.braking, evidence.model).items()
-            if flywheel_reads(evidence, term, fraction)}
+            if flywheel_reads_term(evidence.braking, evidence.model, term, fraction)}
         if not terms:
             return []
         free = (K.BRAKE_GAIN_N_M_PER_PA, K.FLYWHEEL_INERTIA_KG_M2, K.DRAG_COEFF_N_S2_PER_M2,
@@ -91,7 +85,7 @@ class ChannelCrosstalk(Family):
 
 
 def select_terms(runs: Sequence[ClassifiedRun], braking: Sequence[br.Braking],
-                 params: RigParameters) -> dict[ChannelTerm, float]:
+                 params: RigParameters) -> dict[Term[ClassifiedRun], float]:
     """The channels the F_x channel carries, with their fractions, where the true F_x is
     known: before braking (``braking``: the braking runs prepared) and off the ground (the
     other ``runs``); sparse regression, BIC; kept when they move F_x by more than the
@@ -100,11 +94,11 @@ def select_terms(runs: Sequence[ClassifiedRun], braking: Sequence[br.Braking],
     for b in braking:
         mask, y = br.free_rolling_excess(b, params)
         excess.append(y[::DECIMATE])
-        columns.append(_channels(b.run, mask))
+        columns.append(_channels(b.run, mask, params))
     for run in runs:
         if not run.braking:
             excess.append(run.longitudinal_force_n[::DECIMATE])
-            columns.append(_channels(run, np.ones(len(run), dtype=bool)))
+            columns.append(_channels(run, np.ones(len(run), dtype=bool), params))
     y, x = np.concatenate(excess), np.vstack(columns)
     if y.size < 4 * len(LIBRARY):
         return {}
@@ -114,17 +108,9 @@ def select_terms(runs: Sequence[ClassifiedRun], braking: Sequence[br.Braking],
             if abs(c) * top > FORCE_FLOOR_N}
 
 
-def flywheel_reads(evidence: Evidence, term: ChannelTerm, fraction: float) -> bool:
-    """Whether the flywheel's momentum balance reads the F_x channel carrying ``fraction`` of
-    ``term`` too (at least half of it, the same way). A channel's error is read wherever the
-    channel is; a torque on the wheel (a bearing's) also breaks the free-rolling relation,
-    but the flywheel feels what the channel reads and its balance holds."""
-    return carries(evidence.braking, evidence.model, lambda b: term.values(b.run), fraction)
-
-
-def _channels(run: ClassifiedRun, mask: np.ndarray) -> np.ndarray:
+def _channels(run: ClassifiedRun, mask: np.ndarray, params: RigParameters) -> np.ndarray:
     """The library's channels of ``run`` at ``mask``, decimated, shape (m, k)."""
-    return np.column_stack([t.values(run)[mask] for t in LIBRARY])[::DECIMATE]
+    return np.column_stack([variable(t, run, params)[mask] for t in LIBRARY])[::DECIMATE]
 
 
 FAMILY = ChannelCrosstalk()

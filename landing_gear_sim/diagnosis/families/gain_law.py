@@ -10,8 +10,7 @@ of its own (several kept: their names joined by '+').
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Sequence
 from typing import ClassVar
 
 import numpy as np
@@ -27,6 +26,7 @@ from landing_gear_sim.diagnosis.families.base import (
     term_candidate,
 )
 from landing_gear_sim.diagnosis.relations import Relation
+from landing_gear_sim.diagnosis.selection import Term, variable
 from landing_gear_sim.diagnosis.sparse import sparse_coefficients
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
@@ -35,26 +35,18 @@ from msg_tools.units import PA_PER_BAR, display, signed
 MIN_RELATIVE_EFFECT = 0.02  # a term changing the gain by less over its range is dropped
 
 
-@dataclass(frozen=True)
-class GainTerm:
-    """A physical term the brake gain may depend on: the family it names, its slot (the
-    coefficient), its symbol and display unit, the coefficient's admissible magnitude
-    [1/unit of the term] and its values."""
-
-    family: str
-    key: str
-    symbol: str
-    display: tuple[str, float]  # the term's unit in the formula, and SI -> that unit
-    bound: float
-    values: Callable[[br.Braking], np.ndarray]
-
-
-LIBRARY = (
-    GainTerm("sliding_speed", K.BRAKE_GAIN_SLOPE_WHEEL_SPEED_S_PER_RAD, "ω", ("rad/s", 1.0),
-             1 / 200.0, lambda b: b.wheel),
-    GainTerm("pressure_level", K.BRAKE_GAIN_SLOPE_PRESSURE_PER_PA, "P", ("bar", PA_PER_BAR),
-             1 / 60e5, lambda b: b.pressure),
+LIBRARY: tuple[Term[br.Braking], ...] = (
+    Term(K.BRAKE_GAIN_SLOPE_WHEEL_SPEED_S_PER_RAD, "ω", "s/rad", 1 / 200.0,
+         lambda b, params: b.wheel),
+    Term(K.BRAKE_GAIN_SLOPE_PRESSURE_PER_PA, "P", "1/Pa", 1 / 60e5,
+         lambda b, params: b.pressure),
 )
+"""The brake gain's terms: k_b P (1 + Σ c_i x_i), each coefficient's SI unit and admissible
+magnitude."""
+NAMES = {LIBRARY[0].key: "sliding_speed", LIBRARY[1].key: "pressure_level"}
+"""The family each term names."""
+SHOWN = {LIBRARY[0].key: ("rad/s", 1.0), LIBRARY[1].key: ("bar", PA_PER_BAR)}
+"""Each term's variable as the law shows it: its unit, and SI to that unit."""
 
 
 class GainLaw(Family):
@@ -86,20 +78,21 @@ class GainLaw(Family):
         return [Proposal(term_candidate(
             self, [t.key for t in terms], list(terms.values()),
             [(-t.bound, t.bound) for t in terms], (K.BRAKE_GAIN_N_M_PER_PA, *FRICTION),
-            BRAKE_RUNS, WHEEL, reports="+".join(t.family for t in terms)))]
+            BRAKE_RUNS, WHEEL, reports="+".join(NAMES[t.key] for t in terms)))]
 
     def formula(self, candidate: Candidate, params: RigParameters) -> str:
         parts = []
         for t in LIBRARY:
             if t.key in candidate.keys:
-                unit, per_si = t.display
+                unit, per_si = SHOWN[t.key]
                 value = params.number(t.key) * per_si
                 parts.append(f"{signed(value)}·{t.symbol}[{unit}]")
         gain = display(params.number(K.BRAKE_GAIN_N_M_PER_PA), "N m/Pa")
         return f"T_b = {gain}·P·(1 {' '.join(parts)})"
 
 
-def select_terms(runs: Sequence[br.Braking], params: RigParameters) -> dict[GainTerm, float]:
+def select_terms(runs: Sequence[br.Braking], params: RigParameters
+                 ) -> dict[Term[br.Braking], float]:
     """Terms of LIBRARY the torque balance of ``runs`` needs, with their coefficient (the
     sparse fit's, a start for the output-error fit)."""
     ratio, columns = [], []
@@ -107,7 +100,7 @@ def select_terms(runs: Sequence[br.Braking], params: RigParameters) -> dict[Gain
         torque, _ = br.torque_balance(b, params)
         m = np.flatnonzero(br.steady_braking_samples(b))[::DECIMATE]
         ratio.append(torque[m] / (params.number(K.BRAKE_GAIN_N_M_PER_PA) * b.pressure[m]))
-        columns.append(np.column_stack([t.values(b)[m] for t in LIBRARY]))
+        columns.append(np.column_stack([variable(t, b, params)[m] for t in LIBRARY]))
     y, x = np.concatenate(ratio), np.vstack(columns)
     if y.size < 4 * len(LIBRARY):
         return {}

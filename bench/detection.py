@@ -445,7 +445,7 @@ def report(title: str, rows: list[dict]) -> None:
 
 EQUATION_CASES: dict[str, str] = {
     f"discovered {h.family} ({h.name})": h.family
-    for f in REGISTRY if isinstance(f, EquationTerms) for h in f.hidden} | {
+    for f in REGISTRY if isinstance(f, EquationTerms) and f.generic for h in f.hidden} | {
     f"discovered {equation} ({name})": equation for name, (equation, _) in OUTSIDE.items()}
 """Journal truths of the equations' hidden effects -> the equation to name."""
 

@@ -81,13 +81,16 @@ def _bench(root: Path) -> Iterator[Campaign]:
 
 
 def _outside(root: Path, seed: int = 1000, per_cause: int = 3) -> Iterator[Campaign]:
-    """detection.py's plan (its default causes and seeds), OUTSIDE causes only."""
+    """detection.py's plan (its default causes and seeds), OUTSIDE causes only; a cause's
+    campaigns kept under ``root`` keep their seeds (a family added to the registry shifts
+    the plan's seeds, and the guard compares the same campaigns)."""
     causes = [*detection.CASES, *detection.FAMILIES, *detection.OUTSIDE]
     for i, cause in enumerate(causes):
         if cause not in detection.OUTSIDE:
             continue
-        for j in range(per_cause):
-            number = seed + 17 * i + j
+        kept = sorted(int(f.name.rsplit("-", 1)[1])
+                      for f in (root / "outside").glob(f"{cause}-*") if f.is_dir())
+        for number in kept or [seed + 17 * i + j for j in range(per_cause)]:
 
             def make(folder: Path, cause: str = cause, number: int = number) -> None:
                 _write_outside(folder, cause, number)

@@ -29,7 +29,7 @@ from msg_tools.io import read_campaign
 
 RUNS = ("actuator_ramp", "brake_const_10bar", "brake_const_20bar", "brake_const_30bar",
         "brake_osc_low", "brake_osc_high")
-EQUATION_CASES = sorted(h.name for f in REGISTRY if isinstance(f, EquationTerms)
+EQUATION_CASES = sorted(h.name for f in REGISTRY if isinstance(f, EquationTerms) and f.generic
                         for h in f.hidden)
 
 

@@ -166,6 +166,17 @@ class Tensored(TermLibrary):
 
 
 @dataclass(frozen=True)
+class Listed(TermLibrary):
+    """Basis functions as a law names them, a signal's product with itself included
+    (sgn ΔP·ΔP: a valve's stiffness by the port it opens)."""
+
+    listed: Sequence[BasisTerm]
+
+    def terms(self) -> tuple[BasisTerm, ...]:
+        return tuple(self.listed)
+
+
+@dataclass(frozen=True)
 class Without(TermLibrary):
     """``library`` less the terms whose codes the equation's own parameters already own
     (k_b P in the wheel's balance, k_L v² in the loading device's)."""

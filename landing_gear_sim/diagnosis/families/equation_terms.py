@@ -58,11 +58,20 @@ class EquationTerms(Family):
     rank = RANK
 
     def __init_subclass__(cls) -> None:
-        cls.reports = cls.equation = str(cls.library.equation)
+        # a named family over an equation's slot reports its own name (a valve whose
+        # release differs from its apply), a generic one its equation's
+        cls.equation = str(cls.library.equation)
+        cls.reports = cls.__dict__.get("reports", cls.equation)
         slot = cls.library.slot
         cls.keys = tuple(coeff for _, coeff in slot.keys) if slot else tuple(
             t.key for t in cls.library.terms)
         cls.relations = (cls.library.relation, *cls.also_breaks)
+
+    @property
+    def generic(self) -> bool:
+        """Whether it is its equation's generic family (reported as the equation), not a
+        named one over the same slot."""
+        return self.reports == self.equation
 
     def propose(self, evidence: Evidence) -> list[Proposal]:
         """The kept terms, started at their fit, fitted with the parameters the calibration

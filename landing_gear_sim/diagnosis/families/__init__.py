@@ -10,8 +10,9 @@ The diagnosis tries them in this order (:func:`~..discovered.discover`): the val
 channels first, since what they misread distorts every other relation, then the wheel's
 equation; last the equations' generic slots (:mod:`.equation_terms`), for what no named
 family holds. Adding a family: one module here (its words included: the report reads
-them from the registry), its line below, and its row in docs/diagnosis.md; a slot the model
-lacks, in the model too.
+them from the registry), its line below (and its import), its row in docs/diagnosis.md and
+in docs/architecture.md's module table (both tested against the code); a slot the model lacks,
+in the model too. :mod:`.valve_direction` was added that way.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from landing_gear_sim.diagnosis.families import (
     load,
     pressure_skew,
     run_drift,
+    valve_direction,
     valve_dynamics,
     wheel_skew,
 )
@@ -49,6 +51,7 @@ REGISTRY: tuple[Family, ...] = tuple(sorted((
     load.FAMILY,
     equation_terms.VALVE_FAMILY,
     valve_dynamics.FAMILY,
+    valve_direction.FAMILY,
     equation_terms.WHEEL_FAMILY,
     equation_terms.TYRE_FAMILY,
     equation_terms.FX_CHANNEL_FAMILY,

@@ -255,59 +255,111 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
     if not chosen:
         kinds = "/".join(str(k) for k in candidate.runs)
         raise IdentificationError(f"{candidate.cause}: no {kinds} run to fit on")
-    scales = scales or noise_scales(chosen, candidate.channels)
+    references = [base] + ([datasheet] if datasheet is not None else [])
+    problem = _problem(candidate, chosen, base, references, null,
+                       scales or noise_scales(chosen, candidate.channels))
+    if not problem.keys:
+        (error,) = scaled_residuals(chosen, [problem.model], candidate.channels,
+                                    problem.scales)
+        return CandidateFit(candidate, problem.model, {}, {}, error)
+    resumed = bool(problem.own and ended)
+    points = _starts(candidate, problem, references, ended if resumed else None)
+    start = _best_start(candidate, problem, points, tries, resumed)
+    best = _optimise(Objective(problem.residuals, known=start), start[0], MAX_ITERATIONS)
+    return _fitted(candidate, problem, best, chosen)
+
+
+@dataclass(frozen=True)
+class _Problem:
+    """A candidate's fit: the runs it is fitted on, the model its keys (its ``own``, then
+    the free base parameters) are set in, their window, and the channels' scales."""
+
+    chosen: Sequence[ClassifiedRun]
+    model: RigParameters
+    own: tuple[str, ...]
+    keys: tuple[str, ...]
+    window: _Window
+    channels: tuple[str, ...]
+    scales: Scales
+
+    def residuals(self, points: Sequence[np.ndarray]) -> list[np.ndarray]:
+        """The scaled residuals of the model at each of ``points`` (unit box)."""
+        trials = [self.model.replace(dict(zip(self.keys, self.window.value(u), strict=True)),
+                                     "fit") for u in points]
+        return scaled_residuals(self.chosen, trials, self.channels, self.scales)
+
+
+def _problem(candidate: Candidate, chosen: Sequence[ClassifiedRun], base: RigParameters,
+             references: Sequence[RigParameters], null: bool, scales: Scales) -> _Problem:
+    """The fit of ``candidate`` (``null``: its free parameters alone, element off): its own
+    keys within their bounds, the free ones within half and twice the ``references``'."""
     own = () if null else candidate.keys
     model = base if null else switched_on(candidate, base)
     free = [k for k in candidate.free if k not in candidate.keys]
-    references = [base] + ([datasheet] if datasheet is not None else [])
-    keys = [*own, *free]
-    if not keys:
-        (error,) = scaled_residuals(chosen, [model], candidate.channels, scales)
-        return CandidateFit(candidate, model, {}, {}, error)
     own_bounds = candidate.bounds if own else ()
     lower = np.array([b[0] for b in own_bounds]
                      + [0.5 * min(r.number(k) for r in references) for k in free])
     upper = np.array([b[1] for b in own_bounds]
                      + [2.0 * max(r.number(k) for r in references) for k in free])
-    window = _Window(lower, upper)
+    return _Problem(chosen, model, tuple(own), (*own, *free), _Window(lower, upper),
+                    candidate.channels, scales)
 
-    def residuals(points: Sequence[np.ndarray]) -> list[np.ndarray]:
-        trials = [model.replace(dict(zip(keys, window.value(u), strict=True)), "fit")
-                  for u in points]
-        return scaled_residuals(chosen, trials, candidate.channels, scales)
 
-    own_starts = candidate.starts if own and candidate.starts else [()]
-    points = [window.unit(np.array([*(s or [r.number(k) for k in own]),
-                                    *(r.number(k) for k in free)]))
+def _starts(candidate: Candidate, problem: _Problem, references: Sequence[RigParameters],
+            ended: Mapping[str, float] | None) -> list[np.ndarray]:
+    """The start points (unit box): each of the candidate's starts with each reference's
+    free parameters; first, where it ``ended`` when fitted before."""
+    free = problem.keys[len(problem.own):]
+    own_starts = candidate.starts if problem.own and candidate.starts else [()]
+    points = [problem.window.unit(np.array([*(s or [r.number(k) for k in problem.own]),
+                                            *(r.number(k) for k in free)]))
               for s in own_starts for r in references]
-    if own and ended:
+    if ended:
         # where it ended, its free parameters with its keys (a delay ended beside the ω_n
         # it moved; beside the calibrated ω_n it started worse than the catalogue's)
-        points.insert(0, window.unit(np.array([ended.get(k, model.number(k)) for k in keys])))
+        points.insert(0, problem.window.unit(np.array(
+            [ended.get(k, problem.model.number(k)) for k in problem.keys])))
+    return points
+
+
+Start = tuple[np.ndarray, np.ndarray, np.ndarray | None]
+
+
+def _best_start(candidate: Candidate, problem: _Problem, points: list[np.ndarray],
+                tries: int, resumed: bool) -> Start:
+    """Where the fit goes on from: the best start's probe, of the ``tries`` starts of the
+    lowest cost within START_RATIO of the best (``resumed``: where it ended before, alone
+    when it ranks first)."""
     # a start the model does not survive (an unstable valve: inf or nan) is no start
-    at_points = residuals(points)
+    at_points = problem.residuals(points)
     initial = [cost if math.isfinite(cost := float(np.sum(r ** 2))) else math.inf
                for r in at_points]
     if not math.isfinite(min(initial)):
         raise IdentificationError(f"{candidate.cause}: the model diverges from every start")
     order = [i for i in np.argsort(initial)[:tries] if initial[i] <= START_RATIO * min(initial)]
-    if own and ended and order[0] == 0:
+    if resumed and order[0] == 0:
         order = order[:1]  # its probes told the basins apart when it was fitted before
-    start = (points[order[0]], at_points[order[0]], None)
-    if len(order) > 1:
-        # successive halving: the starts' first steps tell the basins apart; running each
-        # to the end cost twice the time and always ended on the same optimum
-        probes = [_optimise(Objective(residuals, known=(points[i], at_points[i], None)),
-                            points[i], PROBE_ITERATIONS) for i in order]
-        probe = min(probes, key=lambda fit: fit.cost)
-        start = (probe.x, probe.fun, probe.jac)
-    best = _optimise(Objective(residuals, known=start), start[0], MAX_ITERATIONS)
+    if len(order) == 1:
+        return points[order[0]], at_points[order[0]], None
+    # successive halving: the starts' first steps tell the basins apart; running each to
+    # the end cost twice the time and always ended on the same optimum
+    probes = [_optimise(Objective(problem.residuals, known=(points[i], at_points[i], None)),
+                        points[i], PROBE_ITERATIONS) for i in order]
+    probe = min(probes, key=lambda fit: fit.cost)
+    return probe.x, probe.fun, probe.jac
+
+
+def _fitted(candidate: Candidate, problem: _Problem, best: OptimizeResult,
+            chosen: Sequence[ClassifiedRun]) -> CandidateFit:
+    """The fit's values and σ (a delay's with the logger's timing) in its model."""
+    keys, window = list(problem.keys), problem.window
     values = window.value(best.x)
     std = covariance_std(best, len(keys)) * window.slope(best.x)
     if K.ACTUATOR_DELAY_S in keys:
         std[keys.index(K.ACTUATOR_DELAY_S)] = math.hypot(
             std[keys.index(K.ACTUATOR_DELAY_S)], input_timing_std_s(chosen))
-    fitted = model.replace(dict(zip(keys, values, strict=True)), f"fit {candidate.cause}")
+    fitted = problem.model.replace(dict(zip(keys, values, strict=True)),
+                                   f"fit {candidate.cause}")
     return CandidateFit(candidate, fitted, dict(zip(keys, map(float, values), strict=True)),
                         dict(zip(keys, map(float, std), strict=True)), best.fun)
 

@@ -65,6 +65,28 @@ def test_clean_logs_violate_no_relation(clean_runs, reference):
     assert violations(checks) == [], [c.describe() for c in violations(checks)]
 
 
+def test_each_relation_checks_itself_and_gives_only_what_it_declares(clean_runs, reference):
+    """A relation is a value its equation declares with its check (what it reads, how it
+    checks): the campaign's checks are exactly theirs, and none gives a relation it does
+    not declare."""
+    from landing_gear_sim.calibration import braking as br
+    from landing_gear_sim.diagnosis.equations.registry import CHECKS
+    from landing_gear_sim.diagnosis.library import Campaign
+
+    prepared = [br.prepare(r, reference) if r.braking else None for r in clean_runs]
+    campaign = Campaign(clean_runs, [b for b in prepared if b is not None])
+    gathered = []
+    for checking in CHECKS:
+        got = [c for run, b in zip(clean_runs, prepared, strict=True)
+               for c in checking.on_run(run, b, reference)]
+        got += checking.on_campaign(campaign, reference)
+        assert {c.relation for c in got} <= set(checking.relations), checking
+        gathered += got
+    assert len({c.relation for c in gathered}) >= 15
+    assert sorted(map(repr, gathered)) == sorted(map(repr, check_campaign(clean_runs,
+                                                                          reference)))
+
+
 def test_load_cell_crosstalk_the_calibration_swallows_is_discovered_and_measured(clean_runs,
                                                                                  reference):
     """A longitudinal channel that is not clean once got 'none': the calibration bent the

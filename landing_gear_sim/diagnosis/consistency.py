@@ -21,9 +21,10 @@ curve, the brake gain or the drag to swallow an effect the relations still show)
 
 Each check is a deviation with its 1-σ from the residual's own noise (autocorrelation
 counted) and a physical floor below which nothing matters; violated when it exceeds both
-Z_VIOLATED σ and the floor. Each relation's check is its equation's
-(:mod:`~landing_gear_sim.diagnosis.equations`); this module reads them all over a campaign,
-and says what they leave unchecked or unresolved. No plotting here
+Z_VIOLATED σ and the floor. Each relation is a value that checks itself, declared by its
+equation (:class:`~.relations.Checking` in :mod:`~landing_gear_sim.diagnosis.equations`);
+this module reads them all over a campaign, and says what they leave unchecked or
+unresolved. No plotting here
 (:mod:`landing_gear_sim.report.diagnosis`).
 """
 
@@ -37,19 +38,14 @@ import numpy as np
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.plausibility import counted_wheel_step
 from landing_gear_sim.calibration.runs import ClassifiedRun
-from landing_gear_sim.diagnosis.equations.fx_channel import free_rolling_force
-from landing_gear_sim.diagnosis.equations.load_cell import no_contact
-from landing_gear_sim.diagnosis.equations.pressure_channel import pressure_timing, zero_current
-from landing_gear_sim.diagnosis.equations.registry import DECLARED, declaring, equation_checks
-from landing_gear_sim.diagnosis.equations.tyre import locked_sliding
-from landing_gear_sim.diagnosis.equations.valve import valve_direction
-from landing_gear_sim.diagnosis.equations.wheel import (
-    LOAD_SPREAD,
-    brake_angle,
-    friction_in_load,
-    gain_trends,
+from landing_gear_sim.diagnosis.equations.registry import (
+    DECLARED,
+    campaign_checks,
+    declaring,
+    run_checks,
 )
-from landing_gear_sim.diagnosis.equations.wheel_channel import RUNOUT_FLOOR, wheel_angle_ripple
+from landing_gear_sim.diagnosis.equations.wheel import LOAD_SPREAD
+from landing_gear_sim.diagnosis.equations.wheel_channel import RUNOUT_FLOOR
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.library import Campaign
 from landing_gear_sim.diagnosis.relations import Z_VIOLATED, Check, Relation, violations
@@ -58,32 +54,13 @@ from landing_gear_sim.model.parameters import RigParameters
 
 def check_campaign(runs: Sequence[ClassifiedRun], params: RigParameters) -> list[Check]:
     """Every check the runs allow, under ``params`` (radius law, wheel inertia, sensor
-    offset of the calibrated model): each run's, then the campaign's, then each library's."""
+    offset of the calibrated model), as each equation declares its relations' checks: each
+    run's, then the campaign's."""
     prepared = [br.prepare(r, params) if r.braking else None for r in runs]
     checks = [c for run, b in zip(runs, prepared, strict=True)
-              for c in _run_checks(run, b, params)]
+              for c in run_checks(run, b, params)]
     braking = [b for b in prepared if b is not None]
-    if braking:
-        checks.extend(gain_trends(braking, params))
-        checks.extend(pressure_timing(braking, params))
-        checks.extend(friction_in_load(braking, params))
-        if (sliding := locked_sliding(braking, params)) is not None:
-            checks.append(sliding)
-    checks.extend(equation_checks(Campaign(runs, braking), params))
-    return checks
-
-
-def _run_checks(run: ClassifiedRun, prepared: br.Braking | None, params: RigParameters
-                ) -> list[Check]:
-    """The checks of one run (``prepared``: its filtered signals, for a braking run)."""
-    checks = [zero_current(run, params)]
-    if prepared is not None:
-        checks.extend([free_rolling_force(prepared, params), wheel_angle_ripple(run, params),
-                       brake_angle(run, prepared, params)])
-    else:
-        checks.extend(no_contact(run, params))
-        checks.append(valve_direction(run, params))
-    return [c for c in checks if c is not None]
+    return checks + campaign_checks(Campaign(runs, braking), params)
 
 
 def unchecked_relations(runs: Sequence[ClassifiedRun], checks: Sequence[Check]) -> list[str]:

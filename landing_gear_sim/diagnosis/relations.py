@@ -1,18 +1,26 @@
-"""The relations the rig measures twice, as values: which relation, and one check of it on a
-run (or the campaign) against its noise and its physical floor. Each equation's module
-(:mod:`~landing_gear_sim.diagnosis.equations`) holds the checks of the relations it
-declares."""
+"""The relations the rig measures twice, as values: which relation (:class:`Relation`), the
+relation as a value that checks itself (:class:`Checking`: what it reads and its check), and
+one check's result on a run (or the campaign) against its noise and its physical floor
+(:class:`Check`). Each equation's module (:mod:`~landing_gear_sim.diagnosis.equations`)
+declares its relations with their checks; :mod:`~.consistency` reads them all."""
 
 from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from landing_gear_sim.calibration.statistics import effective_count
+
+if TYPE_CHECKING:
+    from landing_gear_sim.calibration.braking import Braking
+    from landing_gear_sim.calibration.runs import ClassifiedRun
+    from landing_gear_sim.diagnosis.library import Campaign
+    from landing_gear_sim.model.parameters import RigParameters
 
 Z_VIOLATED = 6.0  # σ: with a dozen checks per campaign, no false alarm from noise
 MIN_SAMPLES = 200  # a check on fewer samples is not made ...
@@ -121,3 +129,53 @@ def structural(checks: Sequence[Check]) -> list[Check]:
 def violations(checks: Sequence[Check]) -> list[Check]:
     """The violated checks, strongest first."""
     return sorted((c for c in checks if c.violated), key=lambda c: -c.z)
+
+
+class Reads(str, enum.Enum):
+    """What a relation's check reads, and so how it is called: a run (``check(run,
+    params)``), a braking run's filtered signals (``check(braking, params)``), the braking
+    runs together (``check(brakings, params)``) or the campaign (``check(campaign,
+    params)``, an equation's library)."""
+
+    ANY_RUN = "each run"
+    ACTUATOR_RUN = "each run off the flywheel"
+    BRAKING_RUN = "each braking run"
+    BRAKING_RUNS = "the braking runs together"
+    CAMPAIGN = "the campaign"
+
+
+Checked = Check | Sequence[Check] | None
+
+
+@dataclass(frozen=True)
+class Checking:
+    """A relation as a value that checks itself (or several relations one reading checks
+    at once, as the brake gain's trends): what it reads (:class:`Reads`) and its check."""
+
+    relations: tuple[Relation, ...]
+    reads: Reads
+    check: Callable[..., Checked]
+
+    def on_run(self, run: ClassifiedRun, braking: Braking | None, params: RigParameters
+               ) -> list[Check]:
+        """Its checks of one run (``braking``: the run's filtered signals, a braking run's)."""
+        args: tuple[Any, ...] | None = {
+            Reads.ANY_RUN: (run,),
+            Reads.ACTUATOR_RUN: (run,) if braking is None else None,
+            Reads.BRAKING_RUN: (braking,) if braking is not None else None,
+        }.get(self.reads)
+        return [] if args is None else _listed(self.check(*args, params))
+
+    def on_campaign(self, campaign: Campaign, params: RigParameters) -> list[Check]:
+        """Its checks of the campaign as a whole."""
+        if self.reads is Reads.CAMPAIGN:
+            return _listed(self.check(campaign, params))
+        if self.reads is Reads.BRAKING_RUNS and campaign.braking:
+            return _listed(self.check(campaign.braking, params))
+        return []
+
+
+def _listed(checked: Checked) -> list[Check]:
+    if checked is None:
+        return []
+    return [checked] if isinstance(checked, Check) else [c for c in checked if c is not None]

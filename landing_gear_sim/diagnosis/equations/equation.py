@@ -13,7 +13,7 @@ import numpy as np
 
 from landing_gear_sim.calibration.braking import Braking
 from landing_gear_sim.calibration.runs import ClassifiedRun
-from landing_gear_sim.diagnosis.relations import Relation
+from landing_gear_sim.diagnosis.relations import Checking, Relation
 from landing_gear_sim.model.parameters import RigParameters
 from msg_tools.run import Run
 
@@ -45,8 +45,13 @@ filtered signals, the model and the run simulated with it, (n,) in its unit."""
 @dataclass(frozen=True)
 class Declared:
     """What an equation declares: its law in words, the measured channel its error shows in,
-    and the relations the rig measures twice that check it."""
+    and the relations the rig measures twice that check it, each with its check."""
 
     law: str
     channel: str
-    relations: tuple[Relation, ...]
+    checks: tuple[Checking, ...]
+
+    @property
+    def relations(self) -> tuple[Relation, ...]:
+        """The relations its checks check."""
+        return tuple(r for c in self.checks for r in c.relations)

@@ -28,7 +28,7 @@ from landing_gear_sim.diagnosis.library import (
     about_run_mean,
     thinned,
 )
-from landing_gear_sim.diagnosis.relations import Relation
+from landing_gear_sim.diagnosis.relations import Checking, Reads, Relation
 from landing_gear_sim.diagnosis.selection import Rows, Term, basis_terms, ordinary_fit, term_columns
 from landing_gear_sim.diagnosis.terms import Shaped
 from landing_gear_sim.model import basis
@@ -119,5 +119,5 @@ def error(run: ClassifiedRun, b: br.Braking, params: RigParameters, simulated: R
     return fly.balance_error(b, params)
 
 
-DECLARED = Declared(f"{LAW} (flywheel)", "flywheel_speed_rad_s",
-                    (Relation.FLYWHEEL_BALANCE,))
+DECLARED = Declared(f"{LAW} (flywheel)", "flywheel_speed_rad_s", (
+    Checking((Relation.FLYWHEEL_BALANCE,), Reads.CAMPAIGN, FLYWHEEL.check),))

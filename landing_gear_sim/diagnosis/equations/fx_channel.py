@@ -27,6 +27,8 @@ from landing_gear_sim.diagnosis.library import (
 )
 from landing_gear_sim.diagnosis.relations import (
     Check,
+    Checking,
+    Reads,
     Relation,
     mean_check,
 )
@@ -173,8 +175,9 @@ def free_rolling_force(b: br.Braking, params: RigParameters) -> Check | None:
 FX_CHANNEL = FxChannelLibrary()
 
 
-DECLARED = Declared(f"{LAW} (the load cell's F_x channel)",
-                    "longitudinal_force_n", (Relation.FREE_ROLLING, Relation.FX_CHANNEL))
+DECLARED = Declared(f"{LAW} (the load cell's F_x channel)", "longitudinal_force_n", (
+    Checking((Relation.FREE_ROLLING,), Reads.BRAKING_RUN, free_rolling_force),
+    Checking((Relation.FX_CHANNEL,), Reads.CAMPAIGN, FX_CHANNEL.check)))
 
 
 def flywheel_reads_term(braking: Sequence[br.Braking], params: RigParameters,

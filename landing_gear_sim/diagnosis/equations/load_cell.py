@@ -7,7 +7,7 @@ from __future__ import annotations
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.diagnosis.equations.equation import Declared
-from landing_gear_sim.diagnosis.relations import Check, Relation, mean_check
+from landing_gear_sim.diagnosis.relations import Check, Checking, Reads, Relation, mean_check
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.sensors import SensorModel
 
@@ -24,5 +24,5 @@ def no_contact(run: ClassifiedRun, params: RigParameters) -> list[Check]:
                                 FORCE_FLOOR_N, "N", run.rate_hz)) is not None]
 
 
-DECLARED = Declared("F_z,read = F_z (the load cell)", "vertical_load_n",
-                    (Relation.NO_CONTACT,))
+DECLARED = Declared("F_z,read = F_z (the load cell)", "vertical_load_n", (
+    Checking((Relation.NO_CONTACT,), Reads.ACTUATOR_RUN, no_contact),))

@@ -23,7 +23,7 @@ from landing_gear_sim.diagnosis.library import (
     about_run_mean,
     thinned,
 )
-from landing_gear_sim.diagnosis.relations import Relation
+from landing_gear_sim.diagnosis.relations import Checking, Reads, Relation
 from landing_gear_sim.diagnosis.selection import Rows, Term, basis_terms, term_columns
 from landing_gear_sim.diagnosis.terms import Shaped, Without
 from landing_gear_sim.model import basis
@@ -98,5 +98,5 @@ def error(run: ClassifiedRun, b: br.Braking, params: RigParameters, simulated: R
     return run.vertical_load_n - simulated.vertical_load_n
 
 
-DECLARED = Declared("F_z follows F_z0 − k_L·v² (loading device)", "vertical_load_n",
-                    (Relation.LOADING_LAW,))
+DECLARED = Declared("F_z follows F_z0 − k_L·v² (loading device)", "vertical_load_n", (
+    Checking((Relation.LOADING_LAW,), Reads.CAMPAIGN, LOADING.check),))

@@ -29,6 +29,8 @@ from landing_gear_sim.diagnosis.library import BrakingLibrary, Campaign, thinned
 from landing_gear_sim.diagnosis.relations import (
     MIN_SAMPLES,
     Check,
+    Checking,
+    Reads,
     Relation,
     mean_check,
 )
@@ -180,6 +182,7 @@ def pressure_timing(runs: Sequence[br.Braking], params: RigParameters) -> list[C
                   f"{MAX_BRAKING_SLIP:g}", lag, lag_std, TIMING_FLOOR_S, "s")]
 
 
-DECLARED = Declared(f"{LAW} (the pressure channel)", "pressure_pa",
-                    (Relation.ZERO_CURRENT, Relation.PRESSURE_TIMING,
-                     Relation.PRESSURE_READING))
+DECLARED = Declared(f"{LAW} (the pressure channel)", "pressure_pa", (
+    Checking((Relation.ZERO_CURRENT,), Reads.ANY_RUN, zero_current),
+    Checking((Relation.PRESSURE_TIMING,), Reads.BRAKING_RUNS, pressure_timing),
+    Checking((Relation.PRESSURE_READING,), Reads.CAMPAIGN, PRESSURE_CHANNEL.check)))

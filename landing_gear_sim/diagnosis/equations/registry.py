@@ -1,7 +1,8 @@
-"""The rig's equations, gathered: what each declares (:data:`DECLARED`, from its module), its
-libraries of terms in the order the diagnosis reads them (:data:`LIBRARIES`), and what
-follows from them for a campaign or a model (each library's relation, the laws a model's
-slots hold). Adding an equation: its module, and its line in :data:`MODULES`.
+"""The rig's equations, gathered: what each declares (:data:`DECLARED`, from its module: its
+law, channel and relations with their checks), its libraries of terms in the order the
+diagnosis reads them (:data:`LIBRARIES`), and what follows from them for a campaign or a
+model (every relation's checks, the laws a model's slots hold). Adding an equation: its
+module, and its line in :data:`MODULES`.
 """
 
 from __future__ import annotations
@@ -9,6 +10,8 @@ from __future__ import annotations
 from types import ModuleType
 from typing import Any
 
+from landing_gear_sim.calibration.braking import Braking
+from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.diagnosis.equations import (
     flywheel,
     fx_channel,
@@ -29,7 +32,7 @@ from landing_gear_sim.diagnosis.equations.tyre import LOCKED_TYRE, TYRE
 from landing_gear_sim.diagnosis.equations.valve import VALVE, VALVE_DYNAMICS
 from landing_gear_sim.diagnosis.equations.wheel import WHEEL
 from landing_gear_sim.diagnosis.library import Campaign, Library
-from landing_gear_sim.diagnosis.relations import Check, Relation
+from landing_gear_sim.diagnosis.relations import Check, Checking, Relation
 from landing_gear_sim.model.parameters import RigParameters
 
 MODULES: dict[Equation, ModuleType] = {
@@ -60,14 +63,40 @@ LIBRARIES: tuple[Library[Any], ...] = (VALVE, VALVE_DYNAMICS, WHEEL, TYRE, FLYWH
 """Every equation's library that checks its relation, in the order they are read (the
 tyre's locked library is not a check: its relation is the locked wheel's)."""
 
-__all__ = ["DECLARED", "FLYWHEEL", "FX_CHANNEL", "LIBRARIES", "LOADING", "LOCKED_TYRE",
-           "PRESSURE_CHANNEL", "TYRE", "VALVE", "VALVE_DYNAMICS", "WHEEL", "declaring",
-           "equation_checks", "held_laws", "held_notes"]
+__all__ = [
+    "DECLARED",
+    "FLYWHEEL",
+    "FX_CHANNEL",
+    "LIBRARIES",
+    "LOADING",
+    "LOCKED_TYRE",
+    "PRESSURE_CHANNEL",
+    "TYRE",
+    "VALVE",
+    "VALVE_DYNAMICS",
+    "WHEEL",
+    "campaign_checks",
+    "declaring",
+    "held_laws",
+    "held_notes",
+    "run_checks",
+]
 
 
-def equation_checks(campaign: Campaign, params: RigParameters) -> list[Check]:
-    """Each library's relation over ``campaign`` under ``params``."""
-    return [c for lib in LIBRARIES if (c := lib.check(campaign, params)) is not None]
+CHECKS: tuple[Checking, ...] = tuple(c for d in DECLARED.values() for c in d.checks)
+"""Every relation's check, as its equation declares it, in the equations' order."""
+
+
+def run_checks(run: ClassifiedRun, braking: Braking | None, params: RigParameters
+               ) -> list[Check]:
+    """Every relation's checks of one run (``braking``: a braking run's filtered signals)."""
+    return [c for checking in CHECKS for c in checking.on_run(run, braking, params)]
+
+
+def campaign_checks(campaign: Campaign, params: RigParameters) -> list[Check]:
+    """Every relation's checks of ``campaign`` as a whole (its braking runs together, its
+    equations' libraries)."""
+    return [c for checking in CHECKS for c in checking.on_campaign(campaign, params)]
 
 
 def held_laws(params: RigParameters) -> list[str]:

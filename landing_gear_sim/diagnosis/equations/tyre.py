@@ -35,7 +35,7 @@ from landing_gear_sim.diagnosis.library import (
     BrakingLibrary,
     about_run_mean,
 )
-from landing_gear_sim.diagnosis.relations import Check, Relation
+from landing_gear_sim.diagnosis.relations import Check, Checking, Reads, Relation
 from landing_gear_sim.diagnosis.selection import Rows, Term, basis_terms, term_columns
 from landing_gear_sim.diagnosis.terms import Shaped
 from landing_gear_sim.model import basis
@@ -217,5 +217,6 @@ TYRE = TyreLibrary()
 LOCKED_TYRE = LockedTyreLibrary()  # the tyre's slot read where the wheel locks; not a check
 
 
-DECLARED = Declared(f"{LAW} (tyre force)", "wheel_speed_rad_s",
-                    (Relation.TYRE_LAW, Relation.LOCKED_SLIDING))
+DECLARED = Declared(f"{LAW} (tyre force)", "wheel_speed_rad_s", (
+    Checking((Relation.TYRE_LAW,), Reads.CAMPAIGN, TYRE.check),
+    Checking((Relation.LOCKED_SLIDING,), Reads.BRAKING_RUNS, locked_sliding)))

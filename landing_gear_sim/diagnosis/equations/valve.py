@@ -41,6 +41,8 @@ from landing_gear_sim.diagnosis.relations import (
     MIN_SAMPLES,
     Z_VIOLATED,
     Check,
+    Checking,
+    Reads,
     Relation,
 )
 from landing_gear_sim.diagnosis.selection import (
@@ -472,4 +474,6 @@ def error(run: ClassifiedRun, b: Braking, params: RigParameters, simulated: Run
 
 
 DECLARED = Declared("P = A(s)·map(i) (valve pressure)", "pressure_pa", (
-    Relation.VALVE_DIRECTION, Relation.VALVE_MAP, Relation.VALVE_DYNAMICS))
+    Checking((Relation.VALVE_DIRECTION,), Reads.ACTUATOR_RUN, valve_direction),
+    Checking((Relation.VALVE_MAP,), Reads.CAMPAIGN, VALVE.check),
+    Checking((Relation.VALVE_DYNAMICS,), Reads.CAMPAIGN, VALVE_DYNAMICS.check)))

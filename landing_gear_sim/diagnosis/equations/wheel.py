@@ -47,6 +47,8 @@ from landing_gear_sim.diagnosis.library import (
 from landing_gear_sim.diagnosis.relations import (
     MIN_SAMPLES,
     Check,
+    Checking,
+    Reads,
     Relation,
 )
 from landing_gear_sim.diagnosis.selection import Rows, Term, basis_terms
@@ -213,10 +215,10 @@ def _trend(relation: Relation, torque: np.ndarray, pressure: np.ndarray, variabl
                  float(coef[1] / gain), float(std[1] / abs(gain)), TREND_FLOOR, "of k_b")
 
 
-def brake_angle(run: ClassifiedRun, prepared: br.Braking, params: RigParameters
-                 ) -> Check | None:
+def brake_angle(prepared: br.Braking, params: RigParameters) -> Check | None:
     """The brake torque's strongest ripple with the wheel's angle while it brakes, beyond
     the model's own run-out of that order [relative to T_b]."""
+    run = prepared.run
     ripple = brake_ripple(run, params, prepared)
     if ripple is None:
         return None
@@ -273,5 +275,8 @@ def error(run: ClassifiedRun, b: br.Braking, params: RigParameters, simulated: R
 
 
 DECLARED = Declared(f"{LAW} (wheel rotation)", "longitudinal_force_n", (
-    Relation.GAIN_IN_SPEED, Relation.GAIN_IN_PRESSURE, Relation.RUN_DRIFT,
-    Relation.FRICTION_IN_LOAD, Relation.BRAKE_ANGLE, Relation.WHEEL_BALANCE))
+    Checking((Relation.GAIN_IN_SPEED, Relation.GAIN_IN_PRESSURE, Relation.RUN_DRIFT),
+             Reads.BRAKING_RUNS, gain_trends),
+    Checking((Relation.FRICTION_IN_LOAD,), Reads.BRAKING_RUNS, friction_in_load),
+    Checking((Relation.BRAKE_ANGLE,), Reads.BRAKING_RUN, brake_angle),
+    Checking((Relation.WHEEL_BALANCE,), Reads.CAMPAIGN, WHEEL.check)))

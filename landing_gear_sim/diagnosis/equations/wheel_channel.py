@@ -6,19 +6,20 @@ channel is smooth in the wheel's angle, once and twice per revolution.
 
 from __future__ import annotations
 
-from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.calibration.braking import Braking
 from landing_gear_sim.calibration.wheel_angle import ORDERS, checked_ripple
 from landing_gear_sim.diagnosis.equations.equation import Declared
-from landing_gear_sim.diagnosis.relations import Check, Relation
+from landing_gear_sim.diagnosis.relations import Check, Checking, Reads, Relation
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.sensors import SensorModel
 
 RUNOUT_FLOOR = 1e-3  # a ripple below 0.1 % of the wheel speed is within the encoder's noise
 
 
-def wheel_angle_ripple(run: ClassifiedRun, params: RigParameters) -> Check | None:
-    """The wheel channel's strongest ripple with the wheel's angle in free rolling, beyond
-    the model's own run-out of that order [relative to ω]."""
+def wheel_angle_ripple(prepared: Braking, params: RigParameters) -> Check | None:
+    """The wheel channel's strongest ripple with the wheel's angle in free rolling, before
+    the run brakes, beyond the model's own run-out of that order [relative to ω]."""
+    run = prepared.run
     ripple = checked_ripple(run)
     if ripple is None:
         return None
@@ -29,5 +30,5 @@ def wheel_angle_ripple(run: ClassifiedRun, params: RigParameters) -> Check | Non
     return max(checks, key=lambda c: c.z)
 
 
-DECLARED = Declared("ω_read = ω (the wheel's encoder)", "wheel_speed_rad_s",
-                    (Relation.WHEEL_ANGLE,))
+DECLARED = Declared("ω_read = ω (the wheel's encoder)", "wheel_speed_rad_s", (
+    Checking((Relation.WHEEL_ANGLE,), Reads.BRAKING_RUN, wheel_angle_ripple),))

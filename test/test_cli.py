@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 
 from landing_gear_sim.cli import build_parser, main
+from landing_gear_sim.model.parameters import load_parameters
 from msg_tools.bag_read import read_bag
 from msg_tools.csv_io import read_csv
 
@@ -104,6 +105,36 @@ def test_params_shows_and_writes_the_effective_set(tmp_path, capsys):
     assert main(["params", "--set", "friction.theta1=0.9", "--write", str(written)]) == 0
     assert main(["params", "--config", str(written)]) == 0
     assert "friction.theta1" in capsys.readouterr().out
+
+
+def test_a_params_file_says_what_each_filled_slot_holds_in_its_equations_units(tmp_path):
+    """A slot's code alone ('37.0') says nothing: the file names its basis function and its
+    coefficient's unit, read from the schema (``params`` imports no equation's library, so
+    it starts at once); each equation's library writes its law in that same unit."""
+    from landing_gear_sim.diagnosis.equations.registry import LIBRARIES
+    from landing_gear_sim.diagnosis.terms import slot_notes
+    from landing_gear_sim.model import basis
+    from landing_gear_sim.model import keys as K
+    from landing_gear_sim.model.parameters import SPECS
+
+    sign = basis.factor_code(basis.OMEGA, basis.SIGN)
+    rig = load_parameters().replace({K.WHEEL_TERMS[1][0]: float(sign),
+                                     K.WHEEL_TERMS[1][1]: 60.0}, "a bearing")
+    assert slot_notes(rig) == {K.WHEEL_TERMS[1][0]: "sgn ω", K.WHEEL_TERMS[1][1]: "N m"}
+    written = tmp_path / "mine.yaml"
+    assert main(["params", "--config", str(_saved(rig, tmp_path)), "--write",
+                 str(written)]) == 0
+    assert "sgn ω" in written.read_text()
+    units = {spec.key: spec.unit.removesuffix(" per phi") for spec in SPECS}
+    for library in LIBRARIES:
+        if library.slot is not None:
+            assert units[library.slot.keys[0][1]] == library.unit, library.equation
+
+
+def _saved(params, folder):
+    path = folder / "rig.yaml"
+    params.to_yaml(path)
+    return path
 
 
 def test_console_script_is_installed():

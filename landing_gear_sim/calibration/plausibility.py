@@ -18,7 +18,6 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-from scipy.integrate import trapezoid
 
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.errors import IdentificationError
@@ -234,7 +233,9 @@ def _check_momentum(run: ClassifiedRun, params: RigParameters) -> None:
     omega = run.flywheel_speed_rad_s[span]
     momentum = params.number(K.FLYWHEEL_INERTIA_KG_M2) / params.number(K.FLYWHEEL_RADIUS_M) \
         * (np.mean(omega[:EDGE_SAMPLES]) - np.mean(omega[-EDGE_SAMPLES:]))
-    impulse = float(trapezoid(run.longitudinal_force_n[span], run.time_s[span]))
+    force, time = run.longitudinal_force_n[span], run.time_s[span]
+    # the trapezoid (scipy.integrate's import cost each command that reads a log 0.7 s)
+    impulse = float(np.sum(np.diff(time) * (force[1:] + force[:-1])) / 2.0)
     ratio = abs(float(momentum) / impulse) if impulse else math.inf
     if PLAUSIBLE_RATIO[0] <= ratio <= PLAUSIBLE_RATIO[1]:
         return

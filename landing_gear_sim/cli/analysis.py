@@ -138,12 +138,12 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
 def _write_params(result: Identification, path: Path) -> None:
     """The params file; a partial one starts with the steps whose values were kept."""
-    from landing_gear_sim.diagnosis.equations.registry import held_notes
+    from landing_gear_sim.diagnosis.terms import slot_notes
 
     header = ["PARTIAL identification (--partial): these steps did not run, their parameters "
               "keep the base values:", *(f"  {step}" for step in result.not_identified)
               ] if result.not_identified else []
-    result.params.to_yaml(path, header=header, notes=held_notes(result.params))
+    result.params.to_yaml(path, header=header, notes=slot_notes(result.params))
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
@@ -237,10 +237,9 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
 
 
 def cmd_metrics(args: argparse.Namespace) -> int:
-    from antiskid.metrics import braking_metrics, stops, unfinished
+    from antiskid.metrics import braking_metrics, metrics_table, stops, unfinished
     from landing_gear_sim.calibration.plausibility import check_units
     from landing_gear_sim.calibration.runs import classify_all
-    from landing_gear_sim.report.braking import metrics_table
 
     check_outputs(files=[args.json, args.plot])
     rig = params_of(args)
@@ -271,8 +270,7 @@ def cmd_antiskid(args: argparse.Namespace) -> int:
         make_controller,
         with_surface,
     )
-    from antiskid.metrics import braking_metrics
-    from landing_gear_sim.report.braking import metrics_table
+    from antiskid.metrics import braking_metrics, metrics_table
     from msg_tools.csv_io import write_csv
 
     check_outputs(files=[args.output, args.json, args.plot])
@@ -308,14 +306,14 @@ def _write_json(path: Path, document: object) -> None:
 
 def _write_braking_outputs(args: argparse.Namespace, run: Run, rig: RigParameters,
                            metrics: BrakingMetrics, default_plot: Path | None = None) -> None:
-    from antiskid.metrics import slip_from, speeds_m_s
-    from landing_gear_sim.report.braking import plot_braking
-
     if args.json:
         _write_json(args.json, metrics.to_dict())
         print(f"  json: {args.json}")
     plot = args.plot or default_plot
     if plot is not None:
+        from antiskid.metrics import slip_from, speeds_m_s
+        from landing_gear_sim.report.braking import plot_braking  # matplotlib: 1 s to start
+
         vehicle, wheel = speeds_m_s(run, rig)
         path = plot_braking(run, slip_from(vehicle, wheel), wheel, vehicle, metrics, plot)
         print(f"  plot: {path}")

@@ -241,10 +241,10 @@ def cmd_bode(args: argparse.Namespace) -> int:
 
 
 def cmd_params(args: argparse.Namespace) -> int:
-    from landing_gear_sim.diagnosis.equations.registry import held_notes
+    from landing_gear_sim.diagnosis.terms import slot_notes
 
     params = params_of(args)
-    notes = held_notes(params)  # what a slot's code names: '37.0' alone says nothing
+    notes = slot_notes(params)  # what a slot's code names: '37.0' alone says nothing
     if args.write:
         params.to_yaml(args.write, notes=notes)
         print(f"wrote {args.write}")

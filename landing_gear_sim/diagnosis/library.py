@@ -33,7 +33,7 @@ from landing_gear_sim.diagnosis.selection import (
     significant,
     term_columns,
 )
-from landing_gear_sim.diagnosis.terms import BasisTerm, coefficient_unit, term_of, written_term
+from landing_gear_sim.diagnosis.terms import BasisTerm, term_of, written_term
 from landing_gear_sim.model.parameters import RigParameters
 
 EDGE_S = 0.5  # the zero-phase filter's ends are left out
@@ -89,12 +89,6 @@ class Library(abc.ABC, Generic[S]):
     def held_law(self, params: RigParameters) -> str | None:
         """Its law with the terms its slot holds in ``params`` (None: it holds none)."""
         return self.law(self.written(params), params) if self._held(params) else None
-
-    def held_notes(self, params: RigParameters) -> dict[str, str]:
-        """By key, what each place its slot fills in ``params`` holds: the basis function a
-        code names, the unit of its coefficient."""
-        return {key: note for code, coeff, term in self._held(params)
-                for key, note in ((code, term.name), (coeff, coefficient_unit(self.unit, term)))}
 
     def _held(self, params: RigParameters) -> list[tuple[str, str, BasisTerm]]:
         """The code key, coefficient key and basis function of each place its slot fills."""

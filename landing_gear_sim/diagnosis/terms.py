@@ -16,7 +16,8 @@ import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from landing_gear_sim.model import basis
+from landing_gear_sim.model import basis_codes as basis
+from landing_gear_sim.model.parameters import SPECS, RigParameters
 from msg_tools.units import display, signed
 
 
@@ -102,6 +103,22 @@ def coefficient_unit(equation_unit: str, term: BasisTerm) -> str:
     per = f"({term.unit})" if not whole and (" " in term.unit or "/" in term.unit) \
         else term.unit
     return f"{equation_unit}/{per}" if equation_unit != "-" else f"1/{per}"
+
+
+def slot_notes(params: RigParameters) -> dict[str, str]:
+    """By key, what each filled place of every generic slot of ``params`` holds: the basis
+    function its code names, and its coefficient's unit, its equation's per φ as the schema
+    gives it (a params file says what '37.0' means; this reads no equation's library, so
+    ``params`` starts at once)."""
+    notes: dict[str, str] = {}
+    for spec in SPECS:
+        if not spec.key.endswith("_coeff") or params.number(spec.key) == 0.0:
+            continue
+        code = spec.key.removesuffix("_coeff") + "_code"
+        term = term_of(round(params.number(code)))
+        notes[code] = term.name
+        notes[spec.key] = coefficient_unit(spec.unit.removesuffix(" per phi"), term)
+    return notes
 
 
 def written_term(value: float, term: BasisTerm, equation_unit: str) -> str:

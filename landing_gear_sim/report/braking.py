@@ -3,13 +3,12 @@ and the metrics table."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
 
-from antiskid.metrics import BrakingMetrics
+from antiskid.metrics import BrakingMetrics, shown
 from landing_gear_sim.report.figures import save_figure
 from msg_tools.run import Run
 from msg_tools.units import PA_PER_BAR
@@ -21,7 +20,7 @@ def plot_braking(run: Run, slip: np.ndarray, wheel_speed_m_s: np.ndarray,
     figure, axes = plt.subplots(3, 1, sharex=True, figsize=(9, 7))
     axes[0].plot(run.time_s, slip, lw=0.8)
     axes[0].set_ylabel("slip [-]")
-    axes[0].set_title(f"{run.name}: efficiency {_number(metrics.braking_efficiency, '.2f')}, stop "
+    axes[0].set_title(f"{run.name}: efficiency {shown(metrics.braking_efficiency, '.2f')}, stop "
                       f"{metrics.stopping_distance_m:.0f} m in {metrics.stopping_time_s:.1f} s, "
                       f"{metrics.lock_events} locks")
     axes[1].plot(run.time_s, flywheel_speed_m_s, label="flywheel (vehicle)", lw=1.0)
@@ -35,26 +34,3 @@ def plot_braking(run: Run, slip: np.ndarray, wheel_speed_m_s: np.ndarray,
         axis.grid(alpha=0.3)
     figure.tight_layout()
     return save_figure(figure, path)
-
-
-def metrics_table(rows: dict[str, BrakingMetrics]) -> str:
-    """One line per run: efficiency, friction, stop, slip, locks, cycling."""
-    header = (f"{'run':24s} {'eff':>5s} {'mu':>5s} {'stop m':>7s} {'stop s':>6s} "
-              f"{'decel':>6s} {'slip rms':>8s} {'max':>5s} {'locks':>5s} {'cycling Hz':>10s}")
-    lines = [header]
-    for name, m in rows.items():
-        lines.append(f"{name:24s} {_number(m.braking_efficiency, '5.3f')} "
-                     f"{_number(m.mean_friction, '5.3f')} "
-                     f"{m.stopping_distance_m:7.1f} {m.stopping_time_s:6.2f} "
-                     f"{m.mean_deceleration_m_s2:6.2f} {m.slip_rms:8.3f} {m.slip_max:5.3f} "
-                     f"{m.lock_events:5d} {m.cycling_frequency_hz:10.2f}")
-    return "\n".join(lines)
-
-
-
-
-def _number(value: float, spec: str) -> str:
-    """``value`` as ``spec``; '-' where the log could not give it (no load cells: friction)."""
-    if math.isfinite(value):
-        return format(value, spec)
-    return "-".rjust(len(format(0.0, spec)))

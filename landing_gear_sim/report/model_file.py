@@ -8,14 +8,15 @@ from __future__ import annotations
 from pathlib import Path
 
 from landing_gear_sim.diagnosis.diagnose import Diagnosis
-from landing_gear_sim.diagnosis.equations.registry import held_laws, held_notes
+from landing_gear_sim.diagnosis.equations.registry import held_laws
+from landing_gear_sim.diagnosis.terms import slot_notes
 from landing_gear_sim.report.words import headline
 
 
 def write_extended_model(result: Diagnosis, path: Path) -> None:
     """``result``'s extended model as a params file at ``path``, with what made it."""
     result.extended.to_yaml(path, header=model_header(result),
-                            notes=held_notes(result.extended))
+                            notes=slot_notes(result.extended))
 
 
 def model_header(result: Diagnosis) -> list[str]:

@@ -78,7 +78,6 @@ __all__ = [
     "campaign_checks",
     "declaring",
     "held_laws",
-    "held_notes",
     "run_checks",
 ]
 
@@ -104,8 +103,3 @@ def held_laws(params: RigParameters) -> list[str]:
     wheel: J_w·ω̇ = r·F_x − T_b − 148 N m·[P > 0.5 bar]')."""
     return [f"the {library.equation}: {law}" for library in LIBRARIES
             if (law := library.held_law(params)) is not None]
-
-
-def held_notes(params: RigParameters) -> dict[str, str]:
-    """By key, what each filled place of every generic slot of ``params`` holds."""
-    return {key: note for library in LIBRARIES for key, note in library.held_notes(params).items()}

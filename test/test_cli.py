@@ -8,12 +8,14 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from landing_gear_sim.cli import build_parser, main
 from landing_gear_sim.model.parameters import load_parameters
 from msg_tools.bag_read import read_bag
 from msg_tools.csv_io import read_csv
+from msg_tools.io import read_run
 
 
 def test_simulate_writes_csv_bag_and_plot(tmp_path, capsys):
@@ -155,6 +157,48 @@ def test_an_unwritable_output_is_refused_before_the_work(tmp_path, capsys):
     assert len(err.strip().splitlines()) == 1
     assert main(["identify", str(tmp_path), "-o", str(tmp_path)]) == 2  # a folder, not a file
     assert "is a folder" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", [["params", "--write", "out.yaml"],
+                                     ["convert", "RUN", "out.csv"]])
+def test_a_file_that_cannot_be_written_names_its_path_and_the_fix(tmp_path, capsys, command):
+    """Issue 62, 20: `params --write` into a folder it cannot write printed a raw
+    '[Errno 1] Operation not permitted'. A path through a file is refused the same way (as
+    root, a read-only folder is not)."""
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    run = tmp_path / "run.csv"
+    if "RUN" in command:
+        assert main(["simulate", "--duration", "1", "--no-plot", "-o", str(run)]) == 0
+        capsys.readouterr()
+    argv = [str(run) if a == "RUN" else a for a in command[:-1]]
+    assert main([*argv, str(blocker / command[-1])]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "Errno" not in err, err
+    assert str(blocker) in err and "cannot write there" in err and "choose" in err, err
+
+
+def test_convert_writes_the_format_its_suffix_names_and_refuses_one_it_cannot(tmp_path,
+                                                                              capsys):
+    """Issue 62, 5: `convert bag OUT.CSV`, `out.tsv` and `out.parquet` all wrote a bag folder.
+    The readers take suffixes case-insensitively, and so does the writer: what it writes
+    reads back as the same run; a suffix it cannot write is refused before the work."""
+    run = tmp_path / "run.csv"
+    assert main(["simulate", "--duration", "1", "--no-plot", "-o", str(run)]) == 0
+    original = read_csv(run)
+    for name in ("OUT.CSV", "out.tsv", "out.txt"):
+        assert main(["convert", str(run), str(tmp_path / name)]) == 0, name
+        written = tmp_path / name
+        assert written.is_file(), name
+        again = read_run(written)
+        assert np.allclose(again.pressure_pa, original.pressure_pa, rtol=1e-6), name
+    capsys.readouterr()
+    assert main(["convert", str(run), str(tmp_path / "out.parquet")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and ".parquet" in err and ".csv" in err, err
+    assert not (tmp_path / "out.parquet").exists()
+    assert main(["convert", str(run), str(tmp_path / "bag")]) == 0  # no suffix: a bag
+    assert read_bag(tmp_path / "bag").pressure_pa.size == original.pressure_pa.size
 
 
 def _subcommands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:

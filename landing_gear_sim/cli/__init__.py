@@ -80,7 +80,8 @@ def _run(args: argparse.Namespace) -> int:
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 2
     except OSError as exc:  # a disk full or a folder gone while writing: still one line
-        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"{PROG}: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
     except Terminated:
         print(f"{PROG}: terminated", file=sys.stderr)

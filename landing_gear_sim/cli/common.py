@@ -157,7 +157,8 @@ def check_outputs(files: Sequence[Path | None] = (), folders: Sequence[Path | No
                 pass
         except OSError as exc:
             raise LandingGearSimError(f"{folder}: cannot write there "
-                                      f"({exc.strerror or exc})") from None
+                                      f"({exc.strerror or exc}); choose a folder you can "
+                                      "write to") from None
 
 
 def write_atomically(path: Path, write: Callable[[Path], object]) -> None:

@@ -91,7 +91,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     conv = sub.add_parser("convert", help="convert a run between CSV and rosbag2")
     conv.add_argument("input", type=InputPath, help="a run: CSV, bag folder or another format")
-    conv.add_argument("output", type=Path, help="*.csv, or a bag folder")
+    conv.add_argument("output", type=Path, help="*.csv, *.txt, *.tsv (any case), or a "
+                      "rosbag2 folder: a name without a suffix")
     add_storage_argument(conv)
     conv.add_argument("--mapping", type=InputPath, help="column-mapping file for a CSV input")
     conv.set_defaults(func=cmd_convert)
@@ -243,6 +244,7 @@ def cmd_bode(args: argparse.Namespace) -> int:
 def cmd_params(args: argparse.Namespace) -> int:
     from landing_gear_sim.diagnosis.terms import slot_notes
 
+    check_outputs(files=[args.write])
     params = params_of(args)
     notes = slot_notes(params)  # what a slot's code names: '37.0' alone says nothing
     if args.write:
@@ -278,15 +280,25 @@ def cmd_campaign(args: argparse.Namespace) -> int:
     return 0
 
 
+TEXT_DELIMITERS = {".csv": ",", ".txt": ",", ".tsv": "\t"}
+"""The text tables ``convert`` writes, by their suffix (any case, as the readers take it)."""
+
+
 def cmd_convert(args: argparse.Namespace) -> int:
     from msg_tools.bag_io import write_bag
     from msg_tools.csv_io import write_csv
 
-    run = read_one(args.input, mapping_of(args))
+    suffix = args.output.suffix.lower()
+    if suffix and suffix not in TEXT_DELIMITERS:
+        raise LandingGearSimError(
+            f"{args.output}: cannot write {args.output.suffix} files; convert writes "
+            f"{', '.join(TEXT_DELIMITERS)} or a rosbag2 folder (a name without a suffix)")
     if args.output.exists():
         raise LandingGearSimError(f"{args.output}: exists already, not overwriting")
-    if args.output.suffix == ".csv":
-        write_csv(run, args.output)
+    check_outputs(folders=[args.output.parent])
+    run = read_one(args.input, mapping_of(args))
+    if suffix:
+        write_csv(run, args.output, TEXT_DELIMITERS[suffix])
     else:
         write_bag(run, args.output, args.storage)
     print(f"{args.input} -> {args.output} ({len(run)} samples)")

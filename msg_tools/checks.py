@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .errors import RunFormatError
@@ -39,6 +41,28 @@ def check_plausible(fields: dict[str, np.ndarray], where: str) -> None:
     check_signs(fields, where)
 
 
+REPEATED_SHARE = 0.1  # of the steps zero: the time's digits, not a duplicated sample
+
+
+def _check_time_digits(time_s: np.ndarray, steps: np.ndarray, where: str) -> None:
+    """Raise where time never decreases but its stamps repeat in runs, each step a whole
+    number of one resolution: the logger wrote the time with too few digits for its rate
+    (2 decimals at 1 kHz), not a duplicated sample."""
+    rising = steps[steps > 0]
+    if np.any(steps < 0) or rising.size == 0 or np.mean(steps == 0) < REPEATED_SHARE:
+        return
+    resolution = float(np.min(rising))
+    if np.max(np.abs(rising / resolution - np.round(rising / resolution))) > 1e-3:
+        return
+    rate = (time_s.size - 1) / float(time_s[-1] - time_s[0])
+    digits = max(0, -math.floor(math.log10(resolution) + 1e-9))
+    needed = max(digits + 1, math.ceil(math.log10(rate)) + 1)
+    raise RunFormatError(
+        f"{where}: time_s is written with too few digits for its rate: {digits} decimals "
+        f"(steps of {resolution:.3g} s) for about {rate:.4g} samples a second, so stamps "
+        f"repeat; log the time with {needed} decimals or more")
+
+
 def check_time(time_s: np.ndarray, where: str) -> None:
     """Raise on non-increasing time, duplicated stamps or a time base in the wrong unit.
 
@@ -48,6 +72,7 @@ def check_time(time_s: np.ndarray, where: str) -> None:
         raise RunFormatError(f"{where}: fewer than 2 samples")
     bad = np.flatnonzero(steps <= 0)
     if bad.size:
+        _check_time_digits(time_s, steps, where)
         kind = "duplicated" if steps[bad[0]] == 0 else "decreasing"
         raise RunFormatError(f"{where}: time is not strictly increasing ({kind} time "
                              f"{time_s[bad[0] + 1]:.6g} s at sample {bad[0] + 1})")

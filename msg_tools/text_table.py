@@ -52,11 +52,15 @@ class Table:
     of them in place, not beside them (a long file's peak memory)."""
 
 
+GZIP_MAGIC = b"\x1f\x8b"
+
+
 def read_text(path: Path) -> str:
-    """The text of ``path`` (gzip-compressed if it ends in ``.gz``), encoding detected."""
+    """The text of ``path`` (gzip-compressed if it ends in ``.gz`` or its bytes say so: a
+    logger's archive keeps its ``.csv`` name), encoding detected."""
     try:
         raw = Path(path).read_bytes()
-        if path.suffix.lower() == ".gz":
+        if path.suffix.lower() == ".gz" or raw.startswith(GZIP_MAGIC):
             raw = gzip.decompress(raw)
     except (OSError, EOFError) as exc:
         raise RunFormatError(f"{path}: cannot read ({getattr(exc, 'strerror', None) or exc})"
@@ -176,13 +180,25 @@ def split(line: str, separator: str) -> list[str]:
 
 
 def sniff(lines: list[str], where: str) -> Dialect:
-    """Separator and decimal mark from the file's last lines (the data, not the preamble)."""
+    """Separator and decimal mark from the file's last lines (the data, not the preamble; a
+    file short enough that they reach its first line is read without it, its header)."""
     sample = [line for line in lines[-SAMPLE_LINES - 5:] if line.strip()][-SAMPLE_LINES:]
     if not sample:
         raise RunFormatError(f"{where}: the file is empty")
     if len(sample) == 1:
         raise RunFormatError(f"{where}: no data rows (the file has one line: "
                              f"{sample[0][:60]!r})")
+    found = _dialect(sample)
+    if found is None and len(sample) > 2 and sample[0] == next(x for x in lines if x.strip()):
+        found = _dialect(sample[1:])
+    if found is None:
+        raise RunFormatError(f"{where}: no table of numbers found (separator , ; tab | or "
+                             "blanks; is this a text table?)")
+    return found
+
+
+def _dialect(sample: list[str]) -> Dialect | None:
+    """The separator and decimal mark that make the most columns of ``sample`` numbers."""
     best: tuple[int, Dialect] | None = None
     for separator in SEPARATORS:
         rows = [split(line, separator) for line in sample]
@@ -193,10 +209,7 @@ def sniff(lines: list[str], where: str) -> Dialect:
         numeric = sum(all(_is_number(r[k], decimal) for r in rows) for k in range(len(rows[0])))
         if numeric >= 2 and (best is None or numeric > best[0]):
             best = (numeric, Dialect(separator, decimal, len(rows[0])))
-    if best is None:
-        raise RunFormatError(f"{where}: no table of numbers found (separator , ; tab | or "
-                             "blanks; is this a text table?)")
-    return best[1]
+    return None if best is None else best[1]
 
 
 def _uses_decimal_comma(rows: list[list[str]]) -> bool:

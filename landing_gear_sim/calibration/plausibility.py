@@ -144,6 +144,11 @@ def _refuse(run: ClassifiedRun, column: str, ratio: float, what: str, unit: str 
             also: str = "") -> None:
     hint = f"; it looks like {unit}{also}: declare the unit (units row, header '[{unit}]' " \
            "or a column mapping)" if unit else "; check its unit and the rig parameters"
+    if ratio < 0 and unit is None:
+        # a transducer wired or logged the other way round: the magnitude may be right
+        hint = ("; its sign is the contract's opposite: a column mapping with scale: -1 reads "
+                "it so" + ("" if PLAUSIBLE_RATIO[0] <= -ratio <= PLAUSIBLE_RATIO[1]
+                           else ", then check its unit and the rig parameters"))
     raise IdentificationError(f"{run.source or run.name}: {column} is {ratio:.3g} times "
                               f"{what}{hint}")
 

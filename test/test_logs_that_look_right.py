@@ -1,0 +1,85 @@
+"""Logs that look right but are not (issue 62): each reproduction of the issue as a test,
+written before its fix. A log is read as what it is, or refused with one line that names the
+file, the real cause and the fix — never a traceback, never the wrong cause."""
+
+from __future__ import annotations
+
+import gzip
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from landing_gear_sim.cli import main
+from landing_gear_sim.model import scenario as sc
+from landing_gear_sim.model.integrate import simulate
+from msg_tools.contract import CSV_COLUMNS, CSV_SCALE_TO_SI, CSV_TO_FIELD
+from msg_tools.io import read_run
+from msg_tools.run import Run
+
+HEADER = ",".join(CSV_COLUMNS)
+
+
+@pytest.fixture(scope="module")
+def run(reference) -> Run:
+    params = reference.replace({"rig_test.max_duration_s": 4.0})
+    return simulate(params, sc.constant_pressure_test(params, 20e5)).to_run(5)
+
+
+def _csv(run: Run, time_format: str = ".6f", **scales: float) -> str:
+    table = {c: getattr(run, CSV_TO_FIELD[c]) / CSV_SCALE_TO_SI[c] * scales.get(c, 1.0)
+             for c in CSV_COLUMNS}
+    rows = [",".join(format(table[c][k], time_format if c == "time_s" else ".9g")
+                     for c in CSV_COLUMNS) for k in range(len(run))]
+    return HEADER + "\n" + "\n".join(rows) + "\n"
+
+
+def _refusal(capsys, argv: list[str]) -> str:
+    """The one line a refused command prints (exit 2, no traceback)."""
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
+    return err
+
+
+def test_a_pressure_of_the_wrong_sign_suggests_scale_minus_one(tmp_path, run, capsys):
+    """Item 12: '-0.986 times what the valve map gives' named no fix; F_x's sign does."""
+    path = tmp_path / "run.csv"
+    path.write_text(_csv(run, brake_pressure_bar=-1.0))
+    err = _refusal(capsys, ["metrics", str(path)])
+    assert "brake_pressure_bar" in err and "sign" in err and "scale: -1" in err, err
+
+
+def test_a_short_table_says_it_is_short_and_how_many_rows_an_analysis_needs(tmp_path, run,
+                                                                          capsys):
+    """Item 14: a 15-row file read 'no table of numbers found'; the table is fine, short."""
+    path = tmp_path / "run.csv"
+    path.write_text("\n".join(_csv(run).splitlines()[:16]) + "\n")
+    err = _refusal(capsys, ["metrics", str(path)])
+    assert "no table of numbers" not in err and "15 rows" in err and "need at least" in err, err
+
+
+def test_a_time_column_with_too_few_digits_for_its_rate_says_so(tmp_path, run, capsys):
+    """Item 16: time written with 2 decimals at 1 kHz read 'duplicated time 0 s at sample
+    1'."""
+    path = tmp_path / "run.csv"
+    path.write_text(_csv(run, time_format=".2f"))
+    err = _refusal(capsys, ["metrics", str(path)])
+    assert "time_s" in err and "digits" in err and "duplicated" not in err, err
+
+
+def test_a_gzip_compressed_csv_under_a_plain_name_is_read(tmp_path, run):
+    """Item 15: a gzip-compressed file named .csv read 'no table of numbers found'."""
+    path = tmp_path / "run.csv"
+    path.write_bytes(gzip.compress(_csv(run).encode()))
+    again = read_run(path)
+    assert len(again) == len(run)
+    assert np.allclose(again.pressure_pa, run.pressure_pa, rtol=1e-6, atol=1.0)
+    assert main(["metrics", str(path)]) == 0
+
+
+def test_nothing_is_written_beside_a_refused_log(tmp_path, run, capsys):
+    path = tmp_path / "run.csv"
+    path.write_text(_csv(run, time_format=".2f"))
+    _refusal(capsys, ["convert", str(path), str(tmp_path / "out.csv")])
+    assert sorted(p.name for p in Path(tmp_path).iterdir()) == ["run.csv"]

@@ -153,9 +153,21 @@ def read_header(above: list[str], dialect: Dialect, wanted: Sequence[str], where
 
 
 def _complete_lines(text: str, where: str) -> tuple[list[str], tuple[str, ...]]:
-    """The text's lines without a last one that a logger stopped writing half-way (no
-    final newline, fewer cells than the rows above, numbers up to where it stops), and a
-    note saying so; a file whose last row is whole but lacks the newline is whole."""
+    """The text's lines without the NUL bytes a power loss pads a file with (4 kB of a
+    block, or a file sparse to its allocated size) and without a last line that a logger
+    stopped writing half-way (no final newline, fewer cells than the rows above, numbers up
+    to where it stops), with a note of each; a file whose last row is whole but lacks the
+    final newline is whole."""
+    unpadded = text.rstrip("\0")
+    padding = len(text) - len(unpadded)
+    notes = (f"{where}: {padding} NUL bytes after its last row (as a power loss leaves a "
+             "file), dropped",) if padding else ()
+    lines, cut = _without_a_cut_line(unpadded, where)
+    return lines, notes + cut
+
+
+def _without_a_cut_line(text: str, where: str) -> tuple[list[str], tuple[str, ...]]:
+    """The text's lines without a last one a logger stopped writing half-way, and a note."""
     lines = text.splitlines()
     if text.endswith(("\n", "\r")) or len(lines) < 3:
         return lines, ()

@@ -83,3 +83,31 @@ def test_nothing_is_written_beside_a_refused_log(tmp_path, run, capsys):
     path.write_text(_csv(run, time_format=".2f"))
     _refusal(capsys, ["convert", str(path), str(tmp_path / "out.csv")])
     assert sorted(p.name for p in Path(tmp_path).iterdir()) == ["run.csv"]
+
+
+@pytest.mark.parametrize("padding", ["4096 NULs", "sparse to 45 MB"])
+@pytest.mark.parametrize("cut_mid_line", [True, False])
+def test_a_log_a_power_loss_padded_with_nul_bytes_keeps_every_complete_row(
+        tmp_path, run, capsys, padding, cut_mid_line):
+    """Item 1: a file cut mid-line and followed by NULs, as a power loss leaves it, raised
+    '_csv.Error: field larger than field limit' (exit 1). The rows up to the cut are read,
+    with a note of what was cut."""
+    whole = _csv(run).encode()
+    cut = whole[:len(whole) // 2]
+    if not cut_mid_line:
+        cut = cut[:cut.rfind(b"\n") + 1]
+    elif cut.endswith(b"\n"):
+        cut = cut[:-3]
+    path = tmp_path / "run.csv"
+    path.write_bytes(cut + (b"\0" * 4096 if padding == "4096 NULs" else b""))
+    if padding != "4096 NULs":
+        with path.open("r+b") as out:
+            out.truncate(45 * 2 ** 20)
+    complete = cut.count(b"\n") - 1
+    again = read_run(path)
+    assert len(again) == complete
+    assert np.allclose(again.time_s, run.time_s[:complete], atol=1e-6)
+    assert any("NUL" in n for n in again.notes), again.notes
+    assert any("cut short" in n for n in again.notes) == cut_mid_line, again.notes
+    assert main(["metrics", str(path)]) == 0
+    assert "NUL" in capsys.readouterr().err

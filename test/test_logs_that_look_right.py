@@ -111,3 +111,14 @@ def test_a_log_a_power_loss_padded_with_nul_bytes_keeps_every_complete_row(
     assert any("cut short" in n for n in again.notes) == cut_mid_line, again.notes
     assert main(["metrics", str(path)]) == 0
     assert "NUL" in capsys.readouterr().err
+
+
+def test_a_command_that_stops_on_an_error_leaves_no_empty_report_folder(tmp_path, run,
+                                                                        capsys):
+    """Item 21: `validate` that stopped on an error left an empty --report folder behind
+    (the check that it can be written had made it)."""
+    (tmp_path / "logs").mkdir()
+    (tmp_path / "logs" / "run.csv").write_text(_csv(run, time_format=".2f"))
+    report = tmp_path / "out" / "report"
+    _refusal(capsys, ["validate", str(tmp_path / "logs"), "--report", str(report)])
+    assert not (tmp_path / "out").exists()

@@ -18,7 +18,7 @@ from collections.abc import Callable, Sequence
 
 from landing_gear_sim import __version__
 from landing_gear_sim.cli import analysis, fleet, model, montecarlo
-from landing_gear_sim.cli.common import PROG, check_inputs
+from landing_gear_sim.cli.common import PROG, check_inputs, remove_empty_made
 from landing_gear_sim.errors import LandingGearSimError
 
 
@@ -89,6 +89,8 @@ def _run(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return 130
+    finally:
+        remove_empty_made()
 
 
 def _entry(command: str) -> Callable[[], int]:

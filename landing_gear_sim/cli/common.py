@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import sys
 import tempfile
@@ -151,6 +152,7 @@ def check_outputs(files: Sequence[Path | None] = (), folders: Sequence[Path | No
             raise LandingGearSimError(f"{path}: is a folder, expected a file name")
     targets = [f.parent for f in files if f is not None] + [d for d in folders if d is not None]
     for folder in targets:
+        MADE.extend(p for p in (folder, *folder.parents) if not p.exists())
         try:
             folder.mkdir(parents=True, exist_ok=True)
             with tempfile.TemporaryFile(dir=folder):
@@ -159,6 +161,19 @@ def check_outputs(files: Sequence[Path | None] = (), folders: Sequence[Path | No
             raise LandingGearSimError(f"{folder}: cannot write there "
                                       f"({exc.strerror or exc}); choose a folder you can "
                                       "write to") from None
+
+
+MADE: list[Path] = []
+"""The folders :func:`check_outputs` made for a command's outputs."""
+
+
+def remove_empty_made() -> None:
+    """Remove the folders made for outputs that a command left empty (it stopped on an
+    error, or was interrupted, before writing them): nothing empty is left behind."""
+    for folder in sorted(set(MADE), key=lambda f: len(f.parts), reverse=True):
+        with contextlib.suppress(OSError):  # not empty, or gone: kept as it is
+            folder.rmdir()
+    MADE.clear()
 
 
 def write_atomically(path: Path, write: Callable[[Path], object]) -> None:

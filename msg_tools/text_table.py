@@ -149,7 +149,20 @@ def read_header(above: list[str], dialect: Dialect, wanted: Sequence[str], where
     units.update({w: units[b] for w, b in bare.items() if w != b and b in units})
     folded = {n.lower(): n for n in names}
     bare = {w: b if b in names else folded.get(b.lower(), b) for w, b in bare.items()}
+    _refuse_twice_named(names, [bare[w] for w in wanted], where)
     return Header(names, units, bare, [w for w in wanted if bare[w] in names])
+
+
+def _refuse_twice_named(names: list[str], used: Sequence[str], where: str) -> None:
+    """Raise where a column the run is read from is named twice: which is the run's cannot
+    be told (an extra pressure column of 0.6 P had been read silently as the first)."""
+    for name in dict.fromkeys(used):
+        positions = [k + 1 for k, n in enumerate(names) if n == name]
+        if len(positions) > 1:
+            raise RunFormatError(
+                f"{where}: column {name!r} appears twice (columns "
+                f"{' and '.join(map(str, positions))}): which one is the run's cannot be "
+                "told; rename the other in the file's header")
 
 
 def _complete_lines(text: str, where: str) -> tuple[list[str], tuple[str, ...]]:

@@ -122,3 +122,16 @@ def test_a_command_that_stops_on_an_error_leaves_no_empty_report_folder(tmp_path
     report = tmp_path / "out" / "report"
     _refusal(capsys, ["validate", str(tmp_path / "logs"), "--report", str(report)])
     assert not (tmp_path / "out").exists()
+
+
+def test_two_columns_of_one_name_are_refused_naming_both_positions(tmp_path, run, capsys):
+    """Item 2: an extra brake_pressure_bar holding 0.6 P was read silently as the first,
+    and compare reported a -61 % pressure fit."""
+    lines = _csv(run).splitlines()
+    at = CSV_COLUMNS.index("brake_pressure_bar")
+    doubled = [lines[0] + ",brake_pressure_bar"] + [
+        f"{line},{0.6 * float(line.split(',')[at]):.9g}" for line in lines[1:]]
+    path = tmp_path / "run.csv"
+    path.write_text("\n".join(doubled) + "\n")
+    err = _refusal(capsys, ["metrics", str(path)])
+    assert "brake_pressure_bar" in err and "3" in err and "8" in err and "twice" in err, err

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -113,8 +114,29 @@ def campaign_sources(folder: Path, skipped: list[str] | None = None) -> list[Pat
     if not folder.is_dir():
         raise RunFormatError(f"{folder}: not a folder")
     found: list[Path] = []
-    _sources(folder, {folder.resolve()}, found, skipped if skipped is not None else [])
-    return found
+    said = skipped if skipped is not None else []
+    _sources(folder, {folder.resolve()}, found, said)
+    return _without_copies(found, said)
+
+
+def _without_copies(found: list[Path], skipped: list[str]) -> list[Path]:
+    """``found`` without files byte-identical to one before them, each said in ``skipped``
+    (a copy under another name had been counted as one more run, and held out)."""
+    sizes = [p.stat().st_size if p.is_file() else -1 for p in found]
+    kept: list[Path] = []
+    first: dict[tuple[int, str], Path] = {}
+    for path, size in zip(found, sizes, strict=True):
+        if size < 0 or sizes.count(size) == 1:  # a folder, or no file of its size
+            kept.append(path)
+            continue
+        key = (size, _digest(path))
+        if key in first:
+            skipped.append(f"{path}: byte-identical to {first[key]}, read once (a copy is "
+                           "not another run)")
+            continue
+        first[key] = path
+        kept.append(path)
+    return kept
 
 
 def _sources(folder: Path, seen: set[Path], found: list[Path], skipped: list[str]) -> None:
@@ -151,11 +173,12 @@ def read_campaign(folder: Path, mapping: Mapping | None = None,
     problems: list[str] = []
     sources = campaign_sources(folder, problems)
     skipped = list(problems)
+    names = _distinct_names(folder, sources, problems)
     for number, source in enumerate(sources, 1):
         if progress and len(sources) > 1:
             progress(f"reading {number}/{len(sources)}: {source.relative_to(folder)}")
         try:
-            parts, notes = _read_parts(source, mapping, _campaign_name(folder, source))
+            parts, notes = _read_parts(source, mapping, names[source])
         except RunFormatError as exc:
             problems.append(str(exc))
             skipped.append(str(exc))
@@ -178,6 +201,33 @@ def _read_parts(path: Path, mapping: Mapping | None, name: str | None = None
     split = split_at_gaps(run)
     rate = rate_change_note(run)
     return tuple(split.parts), (*run.notes, *([rate] if rate else []), *split.notes)
+
+
+def _digest(path: Path) -> str:
+    """The SHA-256 of a file's bytes, read in pieces (a long log is not held twice)."""
+    digest = hashlib.sha256()
+    with path.open("rb") as stream:
+        for piece in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(piece)
+    return digest.hexdigest()
+
+
+def _distinct_names(folder: Path, sources: list[Path], problems: list[str]
+                    ) -> dict[Path, str]:
+    """Each source's run name, distinct: a name two files share (one run in two formats,
+    other data in each) takes its file's suffix, and ``problems`` says so (two rows of one
+    name had been validated, the second plot overwriting the first)."""
+    names: dict[Path, str] = {}
+    for source in sources:
+        name = _campaign_name(folder, source)
+        if name in names.values():
+            first = next(s for s, n in names.items() if n == name)
+            renamed = f"{name}_{source.suffix.lstrip('.').lower() or 'bag'}"
+            problems.append(f"{source}: its run name {name!r} is {first.name}'s too: read as "
+                            f"{renamed!r}")
+            name = renamed
+        names[source] = name
+    return names
 
 
 def _campaign_name(folder: Path, source: Path) -> str:

@@ -14,7 +14,7 @@ from landing_gear_sim.cli import main
 from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
 from msg_tools.contract import CSV_COLUMNS, CSV_SCALE_TO_SI, CSV_TO_FIELD
-from msg_tools.io import read_run
+from msg_tools.io import read_campaign, read_run
 from msg_tools.run import Run
 
 HEADER = ",".join(CSV_COLUMNS)
@@ -135,3 +135,31 @@ def test_two_columns_of_one_name_are_refused_naming_both_positions(tmp_path, run
     path.write_text("\n".join(doubled) + "\n")
     err = _refusal(capsys, ["metrics", str(path)])
     assert "brake_pressure_bar" in err and "3" in err and "8" in err and "twice" in err, err
+
+
+def test_a_byte_identical_copy_of_a_run_is_read_once_with_a_note(tmp_path, run):
+    """Item 7: a copy under another name was counted as a ninth run and held out, with no
+    note (a symlink was already caught)."""
+    text = _csv(run)
+    (tmp_path / "brake_const_20bar.csv").write_text(text)
+    (tmp_path / "copy_of_it.csv").write_text(text)
+    campaign = read_campaign(tmp_path)
+    assert [r.name for r in campaign.runs] == ["brake_const_20bar"]
+    assert any("copy_of_it.csv" in p and "brake_const_20bar.csv" in p and "identical" in p
+               for p in campaign.skipped), campaign.skipped
+
+
+def test_one_run_name_in_two_formats_is_renamed_and_said(tmp_path, run, reference):
+    """Item 6: brake_const_20bar.csv and .tsv holding other data showed as two rows of one
+    name in validate (the second plot overwrote the first); identify listed one and fitted
+    both."""
+    (tmp_path / "brake_const_20bar.csv").write_text(_csv(run))
+    other = simulate(reference.replace({"rig_test.max_duration_s": 4.0}),
+                     sc.constant_pressure_test(reference, 30e5)).to_run(6)
+    (tmp_path / "brake_const_20bar.tsv").write_text(_csv(other).replace(",", "\t"))
+    campaign = read_campaign(tmp_path)
+    names = [r.name for r in campaign.runs]
+    assert len(set(names)) == 2 and "brake_const_20bar" in names, names
+    renamed = next(n for n in names if n != "brake_const_20bar")
+    assert any(renamed in p and "brake_const_20bar.tsv" in p for p in campaign.problems), \
+        campaign.problems

@@ -38,8 +38,9 @@ def _refusal(capsys, argv: list[str]) -> str:
     """The one line a refused command prints (exit 2, no traceback)."""
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
-    return err
+    errors = [line for line in err.splitlines() if line.startswith("landing-gear-sim: error")]
+    assert len(errors) == 1 and "Traceback" not in err, err
+    return errors[0]
 
 
 def test_a_pressure_of_the_wrong_sign_suggests_scale_minus_one(tmp_path, run, capsys):
@@ -163,3 +164,19 @@ def test_one_run_name_in_two_formats_is_renamed_and_said(tmp_path, run, referenc
     renamed = next(n for n in names if n != "brake_const_20bar")
     assert any(renamed in p and "brake_const_20bar.tsv" in p for p in campaign.problems), \
         campaign.problems
+
+
+@pytest.mark.parametrize("channel", ["flywheel_speed_rad_s", "wheel_speed_rad_s"])
+@pytest.mark.parametrize("command", ["metrics", "validate", "diagnose"])
+def test_a_speed_encoder_that_reads_zero_while_the_other_turns_is_named_dead(
+        tmp_path, run, capsys, command, channel):
+    """Item 3: a flywheel channel at 0 throughout while the wheel turned at 190 rad/s gave
+    'stop 0.0 m' in metrics, and 'simulation: time must be strictly increasing' (no file,
+    the wrong cause) in validate, identify and diagnose."""
+    (tmp_path / "logs").mkdir()
+    path = tmp_path / "logs" / "brake_const_20bar.csv"
+    path.write_text(_csv(run, **{channel: 0.0}))
+    target = str(path) if command == "metrics" else str(tmp_path / "logs")
+    err = _refusal(capsys, [command, target])
+    assert "brake_const_20bar.csv" in err and channel in err, err
+    assert "dead" in err and "time must be" not in err, err

@@ -14,6 +14,7 @@ encoder's lines (its resolution named).
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 
@@ -31,6 +32,7 @@ from landing_gear_sim.model.quantities import (
 )
 from landing_gear_sim.model.scenario import BRAKE_ON_CURRENT_A
 from msg_tools.checks import CONTACT_LOAD_N, MIN_BRAKING_SAMPLES, TURNING_RAD_S
+from msg_tools.run import Run
 from msg_tools.units import PA_PER_BAR, UNITS
 
 PLAUSIBLE_RATIO = (0.5, 2.0)  # measured/expected: other rigs differ, not by a unit factor
@@ -47,6 +49,7 @@ LATTICE_LEVELS = 3  # ... and at least this many
 def check_units(runs: Sequence[ClassifiedRun], params: RigParameters) -> None:
     """Raise :class:`IdentificationError` naming the column and its likely unit."""
     for run in runs:
+        _check_dead_speeds(run)  # first: a dead encoder reads as no stop, or no time
         _check_load(run, params)  # first: a load in kN reads as a wheel never on the flywheel
         _check_speeds(run, params)
         _check_pressure(run, params)
@@ -189,6 +192,29 @@ def _other_load(runs: Sequence[ClassifiedRun], params: RigParameters) -> str | N
             f"{params.number(K.LOADING_STATIC_LOAD_N) / 1e3:.3g} kN) near its top: another "
             "rig? Name its static load in the datasheet (--config) so the model loads the "
             "wheel as the rig did")
+
+
+def _check_dead_speeds(run: Run) -> None:
+    """Raise where one speed channel holds one value throughout while the other turns: the
+    wheel is driven by the flywheel, so a dead encoder (unplugged, a channel not wired to
+    the logger) and not a stop ('stop 0.0 m', or 'time must be strictly increasing' once
+    the dead speed was integrated to a distance)."""
+    speeds = {"flywheel_speed_rad_s": run.flywheel_speed_rad_s,
+              "wheel_speed_rad_s": run.wheel_speed_rad_s}
+    if run.lacks(*speeds):
+        return
+    # the flywheel turns with the wheel off it (an actuator run): the wheel only on it
+    on = run.vertical_load_n > CONTACT_LOAD_N if not run.lacks("vertical_load_n") else False
+    for (dead, values), (other, turning) in itertools.permutations(speeds.items()):
+        driving = np.abs(turning) > TURNING_RAD_S
+        if dead == "wheel_speed_rad_s":
+            driving &= on
+        if np.ptp(values) == 0.0 and np.count_nonzero(driving) >= MIN_BRAKING_SAMPLES:
+            raise IdentificationError(
+                f"{run.source or run.name}: {dead} reads {values[0]:g} throughout while "
+                f"{other} turns at up to {np.max(np.abs(turning)):.0f} rad/s: a dead "
+                "channel (an encoder unplugged, or not wired to the logger); the run cannot "
+                "be read without it")
 
 
 def _check_speeds(run: ClassifiedRun, params: RigParameters) -> None:

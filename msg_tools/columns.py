@@ -52,6 +52,7 @@ def run_from_table(table: Table, where: str, name: str, mapping: Mapping | None 
         fields.update({field: np.full(shape, np.nan) for field in absent})
         notes += (f"{where}: {', '.join(absent)} not logged: what needs "
                   f"{'them' if len(absent) > 1 else 'it'} skips this run and says so",)
+    notes += tuple(_unit_against_name(channels, table, where))
     uses = Counter(channel.column for channel in channels.values())
     for contract, channel in channels.items():
         raw = table.columns[channel.column]
@@ -63,6 +64,20 @@ def run_from_table(table: Table, where: str, name: str, mapping: Mapping | None 
             _to_si(channel, raw, where, table.owned and uses[channel.column] == 1)
     check_plausible(fields, where)
     return Run(name=name, source=where, notes=notes, absent=absent, **fields)
+
+
+def _unit_against_name(channels: dict[str, Channel], table: Table, where: str
+                       ) -> list[str]:
+    """A note for each contract-named column whose stated unit is not the one its name
+    says (psi in the units row under brake_pressure_bar): the file's statement is read,
+    and which of the two is wrong only its writer knows."""
+    return [f"{where}: column {contract} says {table.units.get(contract)!r} in its units row "
+            f"while its name says {DEFAULT_MAPPING[contract].unit}: read as "
+            f"{table.units.get(contract)!r}; if the numbers are "
+            f"{DEFAULT_MAPPING[contract].unit}, correct the units row"
+            for contract, channel in channels.items()
+            if channel.column == contract and contract in table.units
+            and channel.unit != DEFAULT_MAPPING[contract].unit]
 
 
 def _channels(table: Table, where: str, mapping: Mapping) -> dict[str, Channel]:

@@ -180,3 +180,16 @@ def test_a_speed_encoder_that_reads_zero_while_the_other_turns_is_named_dead(
     err = _refusal(capsys, [command, target])
     assert "brake_const_20bar.csv" in err and channel in err, err
     assert "dead" in err and "time must be" not in err, err
+
+
+def test_a_units_row_that_contradicts_the_columns_name_is_said(tmp_path, run, capsys):
+    """Item 13: a units row saying psi under brake_pressure_bar was read silently as psi."""
+    lines = _csv(run, brake_pressure_bar=14.5038).splitlines()
+    units = ["s", "A", "psi", "rad/s", "rad/s", "N", "N"]
+    path = tmp_path / "run.csv"
+    path.write_text("\n".join([lines[0], ",".join(units), *lines[1:]]) + "\n")
+    again = read_run(path)
+    assert np.allclose(again.pressure_pa, run.pressure_pa, rtol=1e-4, atol=50.0)
+    said = [n for n in again.notes if "brake_pressure_bar" in n]
+    assert said and "psi" in said[0] and "bar" in said[0] and "units row" in said[0], \
+        again.notes

@@ -193,3 +193,22 @@ def test_a_units_row_that_contradicts_the_columns_name_is_said(tmp_path, run, ca
     said = [n for n in again.notes if "brake_pressure_bar" in n]
     assert said and "psi" in said[0] and "bar" in said[0] and "units row" in said[0], \
         again.notes
+
+
+def test_compare_of_two_runs_given_different_inputs_says_so(tmp_path, reference, capsys):
+    """Item 9: compare of a 20 bar and a 40 bar stop printed fits of -150 % with no hint."""
+    paths = []
+    for bar in (20, 40):
+        paths.append(tmp_path / f"stop{bar}.csv")
+        assert main(["simulate", "--pressure-bar", str(bar), "--duration", "5", "--no-plot",
+                     "-o", str(paths[-1])]) == 0
+    capsys.readouterr()
+    assert main(["compare", str(paths[0]), str(paths[1]), "--plot",
+                 str(tmp_path / "c.png")]) == 0
+    err = capsys.readouterr().err
+    said = [line for line in err.splitlines() if "current" in line and "differ" in line]
+    assert said and " A" in said[0], err
+    capsys.readouterr()
+    assert main(["compare", str(paths[0]), str(paths[0]), "--plot",
+                 str(tmp_path / "same.png")]) == 0
+    assert "differ" not in capsys.readouterr().err

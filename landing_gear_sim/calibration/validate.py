@@ -90,7 +90,27 @@ def compare(measured: Run, simulated: Run) -> RunComparison:
     simulated, notes = on_time_base(simulated, run)
     n = len(simulated)
     scores = {c: score(getattr(run, c)[:n], getattr(simulated, c)) for c in channels_of(run)}
-    return RunComparison(run, simulated, run.kind, scores, notes=notes)
+    inputs = _inputs_differ(run.current_a[:n], simulated.current_a)
+    return RunComparison(run, simulated, run.kind, scores,
+                         notes=(*notes, *([inputs] if inputs else [])))
+
+
+INPUT_SHARE = 0.02  # of the measured current's range: the two runs were given one input
+
+
+def _inputs_differ(measured_a: np.ndarray, simulated_a: np.ndarray) -> str | None:
+    """What says that the two runs were given different current references (their fits
+    then compare two tests, not a model with its rig: a 20 bar stop against a 40 bar one
+    had read −150 % with no word); None when they were given one."""
+    difference = simulated_a - measured_a
+    rms = float(np.sqrt(np.mean(difference ** 2)))
+    span = float(np.ptp(measured_a)) or float(np.max(np.abs(measured_a))) or 1.0
+    if rms <= INPUT_SHARE * span:
+        return None
+    return (f"the two runs' current references differ by {rms:.3g} A rms (at most "
+            f"{float(np.max(np.abs(difference))):.3g} A, {100 * rms / span:.0f} % of the "
+            "measured current's range): they were given different inputs, and their fits "
+            "compare two tests")
 
 
 SAME_RATE = 0.01  # rates closer than this (relative) are one rate

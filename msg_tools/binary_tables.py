@@ -33,18 +33,21 @@ def library(name: str, path: Path) -> ModuleType:
                              f" {INSTALL_HINT}") from None
 
 
-def _same_length(named: Iterable[tuple[str, Any]]) -> dict[str, np.ndarray]:
-    """The 1-D numeric or datetime arrays among ``named``, of the most common length."""
+def _vectors(named: Iterable[tuple[str, Any]], units: dict[str, str] | None = None,
+             notes: tuple[str, ...] = ()) -> Table:
+    """The table of the 1-D numeric or datetime arrays among ``named`` of the most common
+    length; the others' lengths kept (a vector 100 samples short had read as missing)."""
     arrays = {}
     for name, value in named:
         array = np.asarray(value).squeeze()
         if array.ndim == 1 and array.size >= 2 and array.dtype.kind in "fiuM":
             arrays[name] = array
     if not arrays:
-        return {}
+        return Table({}, units or {}, notes)
     lengths = [a.size for a in arrays.values()]
     common = max(set(lengths), key=lengths.count)
-    return {n: a for n, a in arrays.items() if a.size == common}
+    return Table({n: a for n, a in arrays.items() if a.size == common}, units or {}, notes,
+                 other_lengths={n: a.size for n, a in arrays.items() if a.size != common})
 
 
 def read_mat(path: Path) -> Table:
@@ -69,7 +72,7 @@ def read_mat(path: Path) -> Table:
             named += [(f"{name}.{f}", getattr(value, f)) for f in fields]
         else:
             named.append((name, value))
-    return Table(_same_length(named), {})
+    return _vectors(named)
 
 
 def read_hdf5(path: Path) -> Table:
@@ -87,7 +90,7 @@ def read_hdf5(path: Path) -> Table:
             file.visititems(visit)
     except OSError as exc:
         raise RunFormatError(f"{path}: cannot read HDF5 file ({exc})") from None
-    return Table(_same_length(named), {})
+    return _vectors(named)
 
 
 def read_parquet(path: Path) -> Table:
@@ -96,7 +99,7 @@ def read_parquet(path: Path) -> Table:
         table = parquet.read_table(path)
     except Exception as exc:  # pyarrow raises its own error types
         raise RunFormatError(f"{path}: cannot read Parquet file ({exc})") from None
-    return Table(_same_length((n, table.column(n).to_numpy()) for n in table.column_names), {})
+    return _vectors((n, table.column(n).to_numpy()) for n in table.column_names)
 
 
 def read_mdf(path: Path) -> Table:
@@ -125,7 +128,7 @@ def read_mdf(path: Path) -> Table:
     units = {s.name: s.unit for s in chosen.values() if s.unit}
     notes = (f"{path}: channels at {', '.join(f'{r:g}' for r in slower)} Hz resampled onto "
              f"the fastest group's {_rate_hz(base):g} Hz time base",) if slower else ()
-    return Table(_same_length(named), {MASTER_TIME: "s", **units}, notes)
+    return _vectors(named, {MASTER_TIME: "s", **units}, notes)
 
 
 def _rate_hz(timestamps: np.ndarray) -> float:
@@ -154,7 +157,7 @@ def read_tdms(path: Path) -> Table:
             units[MASTER_TIME] = "s"
         except KeyError:  # wf_increment without wf_start_offset: no waveform time track
             pass
-    return Table(_same_length(named), units)
+    return _vectors(named, units)
 
 
 READERS: dict[str, Callable[[Path], Table]] = {

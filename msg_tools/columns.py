@@ -91,6 +91,13 @@ def _channels(table: Table, where: str, mapping: Mapping) -> dict[str, Channel]:
         else:
             missing.append((contract, channel.column))
     lacking = [c for c, _ in missing]
+    for contract, column in missing:
+        if column in table.other_lengths:
+            length = len(next(iter(table.columns.values())))
+            raise RunFormatError(
+                f"{where}: {column} ({contract}) has {table.other_lengths[column]} samples, "
+                f"the file's other vectors {length}: the vectors of one run must be of one "
+                "length (cut or padded when the file was written?)")
     if missing and lacking != list(RIG_COLUMNS) and not set(lacking) <= set(MAY_LACK):
         found = ", ".join(table.columns) or "none"
         named = ", ".join(f"{column} for {contract}" for contract, column in missing)

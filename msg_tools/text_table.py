@@ -17,7 +17,7 @@ import csv
 import gzip
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -50,6 +50,9 @@ class Table:
     owned: bool = False
     """The columns are this table's alone (float arrays no one else holds): the run is made
     of them in place, not beside them (a long file's peak memory)."""
+    other_lengths: dict[str, int] = field(default_factory=dict)
+    """Vectors of a file of named vectors (MATLAB, HDF5, ...) left out for a length other
+    than the table's, with their lengths: a column missing for that is named as such."""
 
 
 GZIP_MAGIC = b"\x1f\x8b"

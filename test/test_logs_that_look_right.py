@@ -212,3 +212,17 @@ def test_compare_of_two_runs_given_different_inputs_says_so(tmp_path, reference,
     assert main(["compare", str(paths[0]), str(paths[0]), "--plot",
                  str(tmp_path / "same.png")]) == 0
     assert "differ" not in capsys.readouterr().err
+
+
+def test_a_mat_file_whose_vector_is_short_names_the_length_mismatch(tmp_path, run, capsys):
+    """Item 17: a .mat whose wheel vector was 100 samples short was reported as a missing
+    column."""
+    import scipy.io
+
+    vectors = {c: getattr(run, CSV_TO_FIELD[c]) / CSV_SCALE_TO_SI[c] for c in CSV_COLUMNS}
+    vectors["wheel_speed_rad_s"] = vectors["wheel_speed_rad_s"][:-100]
+    path = tmp_path / "run.mat"
+    scipy.io.savemat(path, vectors)
+    err = _refusal(capsys, ["metrics", str(path)])
+    assert "wheel_speed_rad_s" in err and str(len(run) - 100) in err, err
+    assert str(len(run)) in err and "missing column" not in err, err

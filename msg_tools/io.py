@@ -17,7 +17,7 @@ from .csv_io import read_csv, read_named, run_name
 from .errors import RunFormatError
 from .mapping import Mapping
 from .run import SIGNALS, Run
-from .timebase import rate_change_note, split_at_gaps, time_base_notes
+from .timebase import end_rates, rate_change_note, split_at_gaps, time_base_notes
 from .workbook import SUFFIXES as WORKBOOK_SUFFIXES
 from .workbook import read_workbook
 
@@ -269,6 +269,16 @@ def resample(run: Run, rate_hz: float) -> Run:
     start = float(run.time_s[0])
     n = int(np.floor((run.time_s[-1] - start) * rate_hz + 1e-9)) + 1
     return at_times(run, start + np.arange(n) / rate_hz)
+
+
+def at_one_rate(run: Run) -> Run:
+    """``run``, or a run whose rate changes resampled at its faster rate, as its note says
+    (statistics over the raw samples had counted the slower part at its own weight: a
+    log from 1 kHz to 500 Hz read an efficiency of 0.367 for 0.359)."""
+    rates = end_rates(run)
+    if rates is None:
+        return run
+    return dataclasses.replace(resample(run, max(rates)), notes=run.notes)
 
 
 def at_times(run: Run, times_s: np.ndarray) -> Run:

@@ -175,14 +175,21 @@ def braking(run: Run) -> np.ndarray:
     return (run.pressure_pa > BRAKING_PRESSURE_PA) & loaded
 
 
-def rate_change_note(run: Run) -> str | None:
-    """A rate at the run's start unlike the one at its end, in words (None: one rate). On
-    its fast clock the slow part's samples read as one-sample gaps, interpolated."""
+def end_rates(run: Run) -> tuple[float, float] | None:
+    """The rates [Hz] at the run's start and at its end, when they differ (None: one)."""
     quarter = max(2, run.time_s.size // 4)
     first, last = (1.0 / float(np.median(np.diff(part)))
                    for part in (run.time_s[:quarter], run.time_s[-quarter:]))
-    if abs(last / first - 1.0) <= RATE_CHANGE:
+    return None if abs(last / first - 1.0) <= RATE_CHANGE else (first, last)
+
+
+def rate_change_note(run: Run) -> str | None:
+    """A rate at the run's start unlike the one at its end, in words (None: one rate). On
+    its fast clock the slow part's samples read as one-sample gaps, interpolated."""
+    rates = end_rates(run)
+    if rates is None:
         return None
+    first, last = rates
     return (f"{run.name}: sampled at {first:.4g} Hz at its start and {last:.4g} Hz at its "
             f"end: the slower part is interpolated onto the faster part's clock or both "
             "are resampled at the mean rate for the model; its noise and detail differ "

@@ -226,3 +226,23 @@ def test_a_mat_file_whose_vector_is_short_names_the_length_mismatch(tmp_path, ru
     err = _refusal(capsys, ["metrics", str(path)])
     assert "wheel_speed_rad_s" in err and str(len(run) - 100) in err, err
     assert str(len(run)) in err and "missing column" not in err, err
+
+
+def test_metrics_of_a_log_that_changes_its_rate_are_those_of_its_signal(tmp_path, reference):
+    """Item 10: a log switching from 1 kHz to 500 Hz mid-run said its slower part was
+    interpolated, but metrics averaged the raw samples (efficiency 0.359 -> 0.367, mu +2.3 %):
+    the slow part counted half."""
+    import json
+
+    whole = tmp_path / "whole.csv"
+    assert main(["simulate", "--pressure-bar", "20", "--no-plot", "-o", str(whole)]) == 0
+    lines = whole.read_text().splitlines()
+    half = len(lines) // 2
+    (tmp_path / "changed.csv").write_text("\n".join(lines[:half] + lines[half::2]) + "\n")
+    found = {}
+    for name in ("whole", "changed"):
+        out = tmp_path / f"{name}.json"
+        assert main(["metrics", str(tmp_path / f"{name}.csv"), "--json", str(out)]) == 0
+        found[name] = json.loads(out.read_text())
+    for key in ("braking_efficiency", "mean_friction", "slip_rms", "stopping_distance_m"):
+        assert found["changed"][key] == pytest.approx(found["whole"][key], rel=2e-3), key

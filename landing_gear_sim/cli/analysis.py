@@ -240,10 +240,11 @@ def cmd_metrics(args: argparse.Namespace) -> int:
     from antiskid.metrics import braking_metrics, metrics_table, stops, unfinished
     from landing_gear_sim.calibration.plausibility import check_units
     from landing_gear_sim.calibration.runs import classify_all
+    from msg_tools.io import at_one_rate
 
     check_outputs(files=[args.json, args.plot])
     rig = params_of(args)
-    run = read_one(args.run, mapping_of(args))
+    run = at_one_rate(read_one(args.run, mapping_of(args)))  # its statistics by time
     parts = stops(run)
     # a unit within every range (a wheel in rpm: slip −7.8 accepted) named as identify does
     check_units(classify_all(parts), rig)

@@ -5,6 +5,7 @@ file, the real cause and the fix — never a traceback, never the wrong cause.""
 from __future__ import annotations
 
 import gzip
+import re
 from pathlib import Path
 
 import numpy as np
@@ -246,3 +247,21 @@ def test_metrics_of_a_log_that_changes_its_rate_are_those_of_its_signal(tmp_path
         found[name] = json.loads(out.read_text())
     for key in ("braking_efficiency", "mean_friction", "slip_rms", "stopping_distance_m"):
         assert found["changed"][key] == pytest.approx(found["whole"][key], rel=2e-3), key
+
+
+@pytest.mark.parametrize("in_kmh", [("wheel_speed_rad_s", "flywheel_speed_rad_s"),
+                                    ("flywheel_speed_rad_s",)])
+def test_speeds_in_km_h_are_named_on_the_channel_that_is_off(tmp_path, run, reference,
+                                                             capsys, in_kmh):
+    """Item 11: both speeds in km/h read 'wheel_speed_rad_s is 0.31 times ...' (0.31 is the
+    wheel's radius); the flywheel alone in km/h blamed the wheel. km/h is named, with the
+    scale that reads it, on the channel that is off."""
+    radius = {"wheel_speed_rad_s": 0.3, "flywheel_speed_rad_s": reference.number(
+        "flywheel.radius_m")}  # the wheel's rolling radius near its static load
+    scales = {c: 3.6 * radius[c] for c in in_kmh}
+    path = tmp_path / "run.csv"
+    path.write_text(_csv(run, **scales))
+    err = _refusal(capsys, ["metrics", str(path)])
+    assert "km/h" in err and "scale" in err, err
+    said = err.split(": ")[3].split(" look")[0]
+    assert set(re.findall(r"\b(?:fly)?wheel_speed_rad_s\b", said)) == set(in_kmh), err

@@ -223,11 +223,13 @@ def _check_speeds(run: ClassifiedRun, params: RigParameters) -> None:
                & (np.abs(run.flywheel_speed_rad_s) > TURNING_RAD_S))
     if not run.braking or rolling.sum() < MIN_BRAKING_SAMPLES:
         return
+    radius = float(np.median(rolling_radius_at(params, load[rolling])))
     wheel = run.wheel_speed_rad_s[rolling] * rolling_radius_at(params, load[rolling])
     ratio = float(np.median(wheel) / np.median(rim_speed_m_s(params, run.flywheel_speed_rad_s[
         rolling])))
     if PLAUSIBLE_RATIO[0] <= ratio <= PLAUSIBLE_RATIO[1]:
         return
+    _refuse_linear_speeds(run, params, ratio, radius)
     wheel_unit, flywheel_unit = _likely(ratio, "speed", "rad/s"), _likely(1 / ratio, "speed",
                                                                          "rad/s")
     if flywheel_unit and not wheel_unit:
@@ -235,6 +237,47 @@ def _check_speeds(run: ClassifiedRun, params: RigParameters) -> None:
                 "what the wheel's speed gives while rolling freely", flywheel_unit)
     _refuse(run, "wheel_speed_rad_s", ratio,
             "what the flywheel's speed gives while rolling freely", wheel_unit)
+
+
+LINEAR_SPEEDS = {"km/h": 3.6, "mph": 2.23694, "m/s": 1.0}
+"""A rim's speed logged in a linear unit, by its factor from m/s."""
+
+
+def _refuse_linear_speeds(run: ClassifiedRun, params: RigParameters, ratio: float,
+                          radius_m: float) -> None:
+    """Raise where the speeds' ``ratio`` (the wheel's rim over the flywheel's) is what a
+    rim speed logged in a linear unit makes, naming the channel that is off and the scale
+    that reads it: the wheel's (ratio f·r), the flywheel's (1/(f·R)), or both (r/R, where
+    the flywheel's momentum against the load cell's impulse, f·R, names the unit); of those
+    near, the nearest. Both in km/h had read 'wheel_speed_rad_s is 0.31 times', the wheel's
+    radius, and the flywheel alone in km/h had blamed the wheel."""
+    rim_m = params.number(K.FLYWHEEL_RADIUS_M)
+    momentum = _momentum_ratio(run, params)
+    found: list[tuple[float, str, dict[str, float]]] = []
+    for unit, factor in LINEAR_SPEEDS.items():
+        wheel = {"wheel_speed_rad_s": 1 / (factor * radius_m)}
+        flywheel = {"flywheel_speed_rad_s": 1 / (factor * rim_m)}
+        found.append((factor * radius_m, unit, wheel))
+        if unit != "m/s":  # a rim of 1 m: m/s is rad/s
+            found.append((1 / (factor * rim_m), unit, flywheel))
+            if momentum is not None and _near(momentum, factor * rim_m):
+                found.append((radius_m / rim_m, unit, wheel | flywheel))
+    near = [(abs(math.log(ratio / expected)), unit, scales)
+            for expected, unit, scales in found if _near(ratio, expected)]
+    if not near:
+        return
+    _, unit, scales = min(near, key=lambda n: n[0])
+    said = " and ".join(scales)
+    fix = " and ".join(f"{c}: scale {v:.4g}" for c, v in scales.items())
+    raise IdentificationError(
+        f"{run.source or run.name}: {said} look{'s' * (len(scales) == 1)} like a rim speed "
+        f"in {unit} (the wheel's rim over the flywheel's reads {ratio:.3g} of what it "
+        f"should): a column mapping reads {'it' if len(scales) == 1 else 'them'} as rad/s "
+        f"({fix})")
+
+
+def _near(value: float, factor: float) -> bool:
+    return abs(value / factor - 1) < MATCH
 
 
 def _check_pressure(run: ClassifiedRun, params: RigParameters) -> None:
@@ -251,15 +294,13 @@ def _check_pressure(run: ClassifiedRun, params: RigParameters) -> None:
 EDGE_SAMPLES = 20  # a speed at a stop's start or end: the mean of this many samples
 
 
-def _check_momentum(run: ClassifiedRun, params: RigParameters) -> None:
-    """The flywheel's momentum lost while the wheel is on it, J_f/R_f·Δω_f, against the
-    impulse of the load cell's force, ∫F_x dt. Both speeds in rpm pass the free-rolling
-    check (they agree); this one names them. The drag (a few percent of the force) is left
-    out: it grows with the speed squared, so a speed in the wrong unit would swell it."""
+def _momentum_ratio(run: ClassifiedRun, params: RigParameters) -> float | None:
+    """The flywheel's momentum lost while the wheel is on it over the load cell's impulse
+    (None: a run that cannot tell)."""
     on = np.flatnonzero((run.time_s >= run.brake_start_s) & (run.vertical_load_n > CONTACT_LOAD_N)
                         & (np.abs(run.flywheel_speed_rad_s) > TURNING_RAD_S))
-    if not run.braking or on.size < MIN_BRAKING_SAMPLES:
-        return
+    if not run.braking or on.size < MIN_BRAKING_SAMPLES or run.lacks("longitudinal_force_n"):
+        return None
     span = slice(on[0], on[-1] + 1)
     omega = run.flywheel_speed_rad_s[span]
     momentum = params.number(K.FLYWHEEL_INERTIA_KG_M2) / params.number(K.FLYWHEEL_RADIUS_M) \
@@ -267,8 +308,16 @@ def _check_momentum(run: ClassifiedRun, params: RigParameters) -> None:
     force, time = run.longitudinal_force_n[span], run.time_s[span]
     # the trapezoid (scipy.integrate's import cost each command that reads a log 0.7 s)
     impulse = float(np.sum(np.diff(time) * (force[1:] + force[:-1])) / 2.0)
-    ratio = abs(float(momentum) / impulse) if impulse else math.inf
-    if PLAUSIBLE_RATIO[0] <= ratio <= PLAUSIBLE_RATIO[1]:
+    return abs(float(momentum) / impulse) if impulse else math.inf
+
+
+def _check_momentum(run: ClassifiedRun, params: RigParameters) -> None:
+    """The flywheel's momentum lost while the wheel is on it, J_f/R_f·Δω_f, against the
+    impulse of the load cell's force, ∫F_x dt. Both speeds in rpm pass the free-rolling
+    check (they agree); this one names them. The drag (a few percent of the force) is left
+    out: it grows with the speed squared, so a speed in the wrong unit would swell it."""
+    ratio = _momentum_ratio(run, params)
+    if ratio is None or PLAUSIBLE_RATIO[0] <= ratio <= PLAUSIBLE_RATIO[1]:
         return
     speed_unit, force_unit = _likely(ratio, "speed", "rad/s"), _likely(1 / ratio, "force", "N")
     if force_unit and not speed_unit:

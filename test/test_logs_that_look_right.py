@@ -265,3 +265,25 @@ def test_speeds_in_km_h_are_named_on_the_channel_that_is_off(tmp_path, run, refe
     assert "km/h" in err and "scale" in err, err
     said = err.split(": ")[3].split(" look")[0]
     assert set(re.findall(r"\b(?:fly)?wheel_speed_rad_s\b", said)) == set(in_kmh), err
+
+
+def test_a_parameter_the_runs_cannot_identify_keeps_its_datasheet_value_with_a_note(
+        tmp_path, reference):
+    """Item 8: an actuator sweep cut to 1.5 s with no current step wrote natural_frequency_hz
+    10.41 ± 1.62e7 and damping_ratio 0.458 ± 1.31e6 into the params file, with no note."""
+    from landing_gear_sim.calibration.campaign import generate_campaign
+    from landing_gear_sim.calibration.identify import identify
+
+    generate_campaign(tmp_path, reference, 8, ("actuator_ramp", "actuator_steps_sweep"))
+    sweep = tmp_path / "actuator_steps_sweep.csv"
+    lines = sweep.read_text().splitlines()
+    sweep.write_text("\n".join(line for line in lines
+                               if not line[0].isdigit() or float(line.split(",")[0]) < 1.5)
+                     + "\n")
+    result = identify(read_campaign(tmp_path).runs, reference, friction=False,
+                      jackknife=False)
+    assert all(abs(e.std) <= abs(e.value) for e in result.estimates), [
+        (e.key, e.value, e.std) for e in result.estimates if abs(e.std) > abs(e.value)]
+    for key in ("actuator.natural_frequency_hz", "actuator.damping_ratio"):
+        assert result.params.number(key) == reference.number(key)
+        assert any(key in p and "cannot" in p for p in result.problems), result.problems

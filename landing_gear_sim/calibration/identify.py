@@ -16,6 +16,7 @@ No plotting here (see :mod:`landing_gear_sim.report`).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -42,7 +43,7 @@ from landing_gear_sim.calibration.runs import (
 )
 from landing_gear_sim.calibration.statistics import Estimate
 from landing_gear_sim.errors import IdentificationError, ParameterError
-from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.parameters import SPECS, RigParameters
 from landing_gear_sim.processes import single_threaded_blas
 from msg_tools.run import Run
 
@@ -78,6 +79,17 @@ class Identification:
                 "estimates": [e.to_json() for e in self.estimates]}
 
 
+def _identified(estimate: Estimate) -> bool:
+    """Whether the runs identify ``estimate``: a finite σ, no larger than the value for a
+    quantity of one sign (a signed one, an offset or a slope, may be 0 within its σ)."""
+    if not math.isfinite(estimate.std):
+        return False
+    return SIGNED.get(estimate.key, True) or abs(estimate.std) <= abs(estimate.value)
+
+
+SIGNED = {spec.key: spec.signed for spec in SPECS}
+
+
 class _Calibration:
     """The parameter set as the steps refine it, the estimates and the problems so far."""
 
@@ -90,8 +102,17 @@ class _Calibration:
         self.say = say
 
     def adopt(self, new: Sequence[Estimate]) -> None:
-        self.estimates.extend(new)
-        self.params = self.params.replace({e.key: e.value for e in new}, "identify")
+        """Take the estimates ``new``, but one the runs cannot identify: a quantity of one
+        sign whose σ exceeds its value keeps the value it had, with a note (a sweep cut
+        before its first step had written ω_n 10.4 ± 1.6e7 Hz into the params file)."""
+        kept = [e for e in new if _identified(e)]
+        for e in new:
+            if e not in kept:
+                self.problems.append(
+                    f"{e.key}: the runs cannot identify it ({e.value:.4g} ± {e.std:.2g}); "
+                    f"kept {self.params.number(e.key):.4g}, the value it had")
+        self.estimates.extend(kept)
+        self.params = self.params.replace({e.key: e.value for e in kept}, "identify")
 
     def forget(self, prefix: str) -> None:
         """Drop the estimates of the keys starting with ``prefix`` (a step redone)."""

@@ -47,6 +47,11 @@ cylinder that leaks, a servo that sags, a lift law of another form); k_L v² is 
 calibration's own."""
 
 
+LAW = "F_z = F_z0 − {k_L}·v²"
+"""The loading device's set point, the one text its declaration and its library write
+(``k_L``: the symbol, or the value)."""
+
+
 class LoadingLibrary(BrakingLibrary):
     """The loading device's set point F_z0 − k_L v² − Σ c_k φ_k(v, t_c): a load that sags
     with speed beside the lift law, a cylinder that leaks. Its error is measured once the
@@ -86,7 +91,7 @@ class LoadingLibrary(BrakingLibrary):
 
     def law(self, written: str, params: RigParameters) -> str:
         lift = display(params.number(K.LOADING_LIFT_COEFF_N_S2_PER_M2), "N s^2/m^2", ".3g")
-        return f"F_z = F_z0 − {lift}·v² {written}"
+        return f"{LAW.format(k_L=lift)} {written}"
 
 
 LOADING = LoadingLibrary()
@@ -98,5 +103,5 @@ def error(run: ClassifiedRun, b: br.Braking, params: RigParameters, simulated: R
     return run.vertical_load_n - simulated.vertical_load_n
 
 
-DECLARED = Declared("F_z follows F_z0 − k_L·v² (loading device)", "vertical_load_n", (
+DECLARED = Declared(f"{LAW.format(k_L='k_L')} (loading device)", "vertical_load_n", (
     Checking((Relation.LOADING_LAW,), Reads.CAMPAIGN, LOADING.check),))

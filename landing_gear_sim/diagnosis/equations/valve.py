@@ -70,6 +70,10 @@ from landing_gear_sim.model.sensors import SensorModel
 from msg_tools.run import Run
 from msg_tools.units import PA_PER_BAR, display
 
+MAP_LAW = "P_static = {k1}·e + {k2}·e²"
+"""The valve's static map, e = I − I0 (the text its declaration and its library write)."""
+DYNAMICS_LAW = "P̈ = ω_n²·(μ·P_static − P{slot}) − 2·{zeta}·ω_n·Ṗ"
+"""A(s), the valve's dynamics (the text its declaration and its library write)."""
 PRESSURE_FLOOR_PA = 0.2 * PA_PER_BAR
 SETTLED_S = 0.3  # after a current change the valve has settled
 SLOW_A_S = 0.5  # slower current changes: A(s) errors leave no direction-locked residual
@@ -194,7 +198,7 @@ class ValveLibrary(Library[Settled]):
     def law(self, written: str, params: RigParameters) -> str:
         k1, k2 = (display(params.number(k), unit, ".3g") for k, unit in (
             (K.ACTUATOR_MAP_K1_PA_PER_A, "Pa/A"), (K.ACTUATOR_MAP_K2_PA_PER_A2, "Pa/A^2")))
-        return f"P_static = {k1}·e + {k2}·e² {written}"
+        return f"{MAP_LAW.format(k1=k1, k2=k2)} {written}"
 
 
 def _excess(valve: Settled, params: RigParameters) -> np.ndarray:
@@ -435,7 +439,8 @@ class ValveDynamicsLibrary(Library[ValveRun]):
     def law(self, written: str, params: RigParameters) -> str:
         wn = display(params.number(K.ACTUATOR_NATURAL_FREQUENCY_HZ), "Hz", ".3g")
         zeta = params.number(K.ACTUATOR_DAMPING_RATIO)
-        return f"P̈ = ω_n²·(μ·P_static − P {written}) − 2·{zeta:.3g}·ω_n·Ṗ, ω_n = 2π·{wn}"
+        return (DYNAMICS_LAW.format(slot=f" {written}", zeta=f"{zeta:.3g}")
+                + f", ω_n = 2π·{wn}")
 
 
 VALVE = ValveLibrary()
@@ -473,7 +478,8 @@ def error(run: ClassifiedRun, b: Braking, params: RigParameters, simulated: Run
     return output_error(run, simulated)
 
 
-DECLARED = Declared("P = A(s)·map(i) (valve pressure)", "pressure_pa", (
+DECLARED = Declared(f"P = A(s)·P_static, {DYNAMICS_LAW.format(slot='', zeta='ζ')}, "
+                    f"{MAP_LAW.format(k1='k1', k2='k2')} (valve pressure)", "pressure_pa", (
     Checking((Relation.VALVE_DIRECTION,), Reads.ACTUATOR_RUN, valve_direction),
     Checking((Relation.VALVE_MAP,), Reads.CAMPAIGN, VALVE.check),
     Checking((Relation.VALVE_DYNAMICS,), Reads.CAMPAIGN, VALVE_DYNAMICS.check)))

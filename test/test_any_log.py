@@ -189,9 +189,10 @@ def test_a_step_log_of_a_slow_valve_gives_its_delay_and_a_release_unlike_its_app
     assert result.verdict == "actuator_delay", [(f.cause, f.delta_bic, f.held_out, f.reason)
                                                 for f in result.candidates]
     assert causes["actuator_delay"].parameters["delay_s"] == pytest.approx(delay, rel=0.1)
+    # a release unlike the apply is the named family's (issue 60), stiffer applying
     valve = causes.get("discovered")
-    assert valve is not None and valve.family == "valve", result.findings
-    assert valve.parameters.get("sgn Ṗ·ΔP", 0.0) > 0.0, valve.term  # stiffer rising
+    assert valve is not None and valve.family == "valve_direction", result.findings
+    assert valve.parameters.get("sgn ΔP·ΔP", 0.0) > 0.0, valve.term
     assert valve.held_out is not None and valve.held_out < 0
     assert valve.fit_after["pressure_pa"] >= 96.0  # the later steps, as held out (were 91 %)
     # the calibration's note that the model lacks a delay is answered by the verdict

@@ -28,6 +28,7 @@ import yaml
 from rosbags.rosbag2 import Reader, ReaderError, Writer
 
 from .bag_io import BAG_VERSION, STORAGE, TYPESTORE
+from .bag_recover import recovered
 from .errors import RunFormatError
 
 OPEN_SEGMENT = ".open_segment"
@@ -104,7 +105,7 @@ class SegmentedBagWriter:
 
     def _join_segments(self) -> None:
         files = [s["relative_file_paths"][0] for s in self._closed]
-        self._closed = [_join(self.path, files, self._topics, self._storage)]
+        self._closed = [_join(self.path, self.path, files, self._topics, self._storage)]
 
     def _open(self) -> None:
         shutil.rmtree(self.path / OPEN_SEGMENT, ignore_errors=True)
@@ -159,31 +160,37 @@ def join_bag(path: Path, say: Callable[[str], object] | None = None) -> tuple[in
     starts (~11 µs a message: a 300 s run's 1.5 M take ~16 s). Returns the number of files
     joined (1: already one, nothing done) and of messages."""
     path = Path(path)
-    try:
-        info = yaml.safe_load((path / "metadata.yaml").read_text())[META]
-        storage = info["storage_identifier"]
-        files = info["relative_file_paths"]
-        with Reader(path) as reader:
-            topics = {c.topic: c.msgtype for c in reader.connections}
-    except (OSError, KeyError, TypeError, yaml.YAMLError, ReaderError) as error:
-        raise RunFormatError(f"{path}: not a readable rosbag2 folder ({error})") from error
-    if storage not in STORAGE:
-        raise RunFormatError(f"{path}: storage {storage!r} cannot be joined (mcap, sqlite3)")
-    if len(files) > 1:
-        if say is not None:
-            say(f"joining {len(files)} segments ({info['message_count']} messages) …")
-        info = _join(path, files, topics, storage)
+    with recovered([path]) as (readable, notes):
+        for note in notes:  # a segment a crash cut short, read as metrics reads it
+            if say is not None:
+                say(f"{path}: {note}")
+        try:
+            info = yaml.safe_load((path / "metadata.yaml").read_text())[META]
+            storage = info["storage_identifier"]
+            files = info["relative_file_paths"]
+            with Reader(readable[0]) as reader:
+                topics = {c.topic: c.msgtype for c in reader.connections}
+        except (OSError, KeyError, TypeError, yaml.YAMLError, ReaderError) as error:
+            raise RunFormatError(f"{path}: not a readable rosbag2 folder ({error})"
+                                 ) from error
+        if storage not in STORAGE:
+            raise RunFormatError(f"{path}: storage {storage!r} cannot be joined (mcap, "
+                                 "sqlite3)")
+        if len(files) > 1 or notes:
+            if say is not None:
+                say(f"joining {len(files)} segments ({info['message_count']} messages) …")
+            info = _join(path, readable[0], files, topics, storage)
     return len(files), int(info["message_count"])
 
 
-def _join(path: Path, files: list[str], topics: dict[str, str], storage: str
-          ) -> dict[str, Any]:
-    """Write the bag ``path``'s messages into one storage file beside its segments (the
-    storage ``files`` it lists), list it in their place, remove them; the joined file's
-    metadata."""
+def _join(path: Path, source: Path, files: list[str], topics: dict[str, str],
+          storage: str) -> dict[str, Any]:
+    """Write the bag ``path``'s messages (read from ``source``: itself, or its recovered
+    copy) into one storage file beside its segments (the storage ``files`` it lists), list
+    it in their place, remove them; the joined file's metadata."""
     work = path / JOINING
     shutil.rmtree(work, ignore_errors=True)
-    with Reader(path) as reader, Writer(work / path.name, version=BAG_VERSION,
+    with Reader(source) as reader, Writer(work / path.name, version=BAG_VERSION,
                                         storage_plugin=STORAGE[storage]) as writer:
         connections = {topic: writer.add_connection(topic, kind, typestore=TYPESTORE)
                        for topic, kind in topics.items()}

@@ -355,6 +355,21 @@ def test_the_join_command_joins_the_segments_a_stopped_recording_kept(tmp_path, 
     assert "one storage file already (30 messages)" in capsys.readouterr().out
 
 
+def test_join_recovers_a_segment_that_lost_its_footer_and_says_which(tmp_path, capsys):
+    """Issue 62, item 19: join of a bag whose second segment lost its footer failed without
+    naming the segment, while metrics recovered the same bag."""
+    from landing_gear_sim.cli import main
+
+    _segmented(tmp_path / "bag", "mcap").close(join=False)
+    segments = sorted((tmp_path / "bag").glob("*.mcap"))
+    second = segments[1]
+    second.write_bytes(second.read_bytes()[:-200])  # the footer and summary gone
+    assert main(["join", str(tmp_path / "bag")]) == 0
+    out = capsys.readouterr()
+    assert second.name in out.out + out.err and "recovered" in out.out + out.err, out
+    assert _values(tmp_path / "bag") == list(range(30))
+
+
 def test_the_join_command_refuses_a_folder_that_is_no_bag_in_one_line(tmp_path, capsys):
     from landing_gear_sim.cli import main
 

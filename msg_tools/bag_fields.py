@@ -21,6 +21,7 @@ from typing import Any
 from .contract import (
     ATMOSPHERE_PA,
     LEGACY_CURRENT_TYPE,
+    MAY_LACK,
     NAMESPACE,
     TOPIC_CURRENT,
     TOPIC_FLYWHEEL,
@@ -112,6 +113,9 @@ def resolve(mapping: dict[str, Channel], types: Mapping[str, str], where: str) -
     sources = []
     for contract, (default_topic, default_field) in CONTRACT_SOURCES.items():
         channel = mapping[contract]
+        if (not channel.topic and contract in MAY_LACK
+                and not _matching(default_topic, types)):
+            continue  # a braking log may lack it, as a CSV may lack its column
         topic = channel.topic or _find_topic(default_topic, types, contract, where)
         if topic not in topics:
             raise RunFormatError(f"{where}: bag has no topic {topic} (for {contract}; it has "
@@ -126,14 +130,19 @@ def _listing(types: Mapping[str, str]) -> str:
     return ", ".join(f"{topic} ({kind})" for topic, kind in sorted(types.items())) or "no topic"
 
 
-def _find_topic(contract_topic: str, types: Mapping[str, str], contract: str, where: str
-                ) -> str:
-    topics = sorted(types)
-    if contract_topic in topics:
-        return contract_topic
+def _matching(contract_topic: str, types: Mapping[str, str]) -> list[str]:
+    """The bag's topics that may be ``contract_topic``: itself, or one ending as it does
+    (another namespace)."""
+    if contract_topic in types:
+        return [contract_topic]
     tail = contract_topic.removeprefix(f"/{NAMESPACE}")
     tails = {tail, tail.removesuffix("s")} if tail.endswith("joint_states") else {tail}
-    found = [t for t in topics if any(t.endswith(x) for x in tails)]
+    return [t for t in sorted(types) if any(t.endswith(x) for x in tails)]
+
+
+def _find_topic(contract_topic: str, types: Mapping[str, str], contract: str, where: str
+                ) -> str:
+    found = _matching(contract_topic, types)
     if len(found) == 1:
         return found[0]
     hint = (f"topics {', '.join(found)} all match" if found

@@ -22,7 +22,7 @@ from .bag_fields import Source, resolve
 from .bag_io import TYPESTORE
 from .bag_recover import recovered
 from .checks import check_plausible
-from .contract import CSV_TO_FIELD
+from .contract import CSV_TO_FIELD, MAY_LACK
 from .derivative import speed_from_angle
 from .errors import RunFormatError
 from .mapping import DEFAULT_MAPPING, Mapping
@@ -74,8 +74,15 @@ def read_bag(path: Path, name: str | None = None, mapping: Mapping | None = None
     except Exception as exc:  # rosbags raises several types for damaged bags
         raise RunFormatError(f"{where}: cannot read bag ({exc})") from None
     fields = _on_wheel_base(series, sources, where)
+    logged = {s.contract for s in sources}
+    absent = tuple(CSV_TO_FIELD[c] for c in MAY_LACK if c not in logged)
+    if absent:  # as a CSV without those columns: what needs them skips the run, and says so
+        fields.update({field: np.full(fields["time_s"].shape, np.nan) for field in absent})
+        notes.append(f"{', '.join(absent)} not logged (no topic): what needs "
+                     f"{'them' if len(absent) > 1 else 'it'} skips this run and says so")
     check_plausible(fields, where)
-    return Run(name=name or path.stem, source=where, notes=tuple(notes), absent=(), **fields)
+    return Run(name=name or path.stem, source=where, notes=tuple(notes), absent=absent,
+               **fields)
 
 
 def _without_interfaces(reader: AnyReader) -> AnyReader:

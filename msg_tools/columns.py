@@ -9,15 +9,12 @@ from dataclasses import replace
 import numpy as np
 
 from .checks import check_plausible
-from .contract import CSV_COLUMNS, CSV_TO_FIELD, RIG_COLUMNS
+from .contract import CSV_COLUMNS, CSV_TO_FIELD, MAY_LACK, RIG_COLUMNS
 from .errors import RunFormatError
 from .mapping import DATETIME, DEFAULT_MAPPING, Channel, Mapping
 from .run import Run
 from .text_table import MASTER_TIME, Table
 from .units import QUANTITY, UNITS, parse_unit
-
-MAY_LACK = ("flywheel_speed_rad_s", "vertical_load_N", "longitudinal_force_N")
-"""The columns a braking log may lack (a logger without load cells or a flywheel encoder)."""
 
 
 def wanted_columns(mapping: Mapping) -> list[str]:

@@ -60,3 +60,6 @@ TOPIC_TYPES: dict[str, str] = {
     TOPIC_FLYWHEEL: "sensor_msgs/msg/JointState",
     TOPIC_WRENCH: "geometry_msgs/msg/WrenchStamped",
 }
+
+MAY_LACK = ("flywheel_speed_rad_s", "vertical_load_N", "longitudinal_force_N")
+"""The columns a braking log may lack (a logger without load cells or a flywheel encoder)."""

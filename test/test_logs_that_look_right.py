@@ -287,3 +287,26 @@ def test_a_parameter_the_runs_cannot_identify_keeps_its_datasheet_value_with_a_n
     for key in ("actuator.natural_frequency_hz", "actuator.damping_ratio"):
         assert result.params.number(key) == reference.number(key)
         assert any(key in p and "cannot" in p for p in result.problems), result.problems
+
+
+def test_a_bag_without_the_flywheel_topic_reads_as_a_csv_without_that_column(tmp_path, run):
+    """Item 18: a bag without the flywheel's topic was refused, while a CSV without that
+    column is read (docs/data-contract.md: a braking log may lack it)."""
+    from rosbags.rosbag2 import Reader, Writer
+
+    from msg_tools.bag_io import BAG_VERSION, TYPESTORE, write_bag
+    from msg_tools.bag_read import read_bag
+    from msg_tools.contract import TOPIC_FLYWHEEL
+
+    write_bag(run, tmp_path / "full")
+    with Reader(tmp_path / "full") as reader, Writer(tmp_path / "bag",
+                                                     version=BAG_VERSION) as writer:
+        kept = {c.id: writer.add_connection(c.topic, c.msgtype, typestore=TYPESTORE)
+                for c in reader.connections if c.topic != TOPIC_FLYWHEEL}
+        for connection, stamp, raw in reader.messages():
+            if connection.id in kept:
+                writer.write(kept[connection.id], stamp, raw)
+    again = read_bag(tmp_path / "bag")
+    assert again.lacks("flywheel_speed_rad_s") == ("flywheel_speed_rad_s",)
+    assert np.allclose(again.wheel_speed_rad_s, run.wheel_speed_rad_s, atol=1e-6)
+    assert any("flywheel_speed_rad_s" in n and "not logged" in n for n in again.notes)

@@ -101,11 +101,13 @@ class _Calibration:
         self.frf: FrfEstimate | None = None
         self.say = say
 
-    def adopt(self, new: Sequence[Estimate]) -> None:
+    def adopt(self, new: Sequence[Estimate], start: bool = False) -> None:
         """Take the estimates ``new``, but one the runs cannot identify: a quantity of one
         sign whose σ exceeds its value keeps the value it had, with a note (a sweep cut
-        before its first step had written ω_n 10.4 ± 1.6e7 Hz into the params file)."""
-        kept = [e for e in new if _identified(e)]
+        before its first step had written ω_n 10.4 ± 1.6e7 Hz into the params file).
+        ``start``: estimates a later step refines, all taken (a friction fit's ϑ stuck on
+        its bound is the refinement's business)."""
+        kept = [e for e in new if start or _identified(e)]
         for e in new:
             if e not in kept:
                 self.problems.append(
@@ -221,7 +223,7 @@ def _no_tyre_curve(params: RigParameters) -> str | None:
 def _friction_step(state: _Calibration, runs: Sequence[ClassifiedRun],
                    prepared: Sequence[br.Braking], fix_theta3: bool, jackknife: bool) -> None:
     before = state.params
-    state.adopt(fit_friction(prepared, state.params, fix_theta3))
+    state.adopt(fit_friction(prepared, state.params, fix_theta3), start=not fix_theta3)
     if fix_theta3:
         return
     implausible = _no_tyre_curve(state.params)

@@ -18,6 +18,7 @@ from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.elements import slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import (
+    friction_at,
     gear_walk_modes,
     load_factor_at,
     logged_or_set_load_n,
@@ -32,6 +33,7 @@ from msg_tools.units import PA_PER_BAR
 
 LOCK_SLIP = 0.95  # a wheel at 95 % slip or more is locked
 LOCK_MIN_SPEED_M_S = 5.0  # locks below this speed are the stop itself, not a skid
+LOCK_FRICTION_SHARE = 0.25  # a lock's μ this far from the curve's μ(1) is no sliding tyre
 MIN_LOAD_N = 1000.0  # below this the wheel is not on the flywheel: no friction to speak of
 CYCLE_PROMINENCE_PA = 2 * PA_PER_BAR  # a pressure cycle is a peak standing 2 bar above its valleys
 GEAR_WALK_BAND = 0.3  # cycling within ±30 % of the gear-walk frequency is flagged
@@ -164,6 +166,30 @@ def unfinished(run: Run, rig: RigParameters) -> str | None:
         return None
     return (f"{run.name}: the log ends at {end:.3g} m/s, braking from {start:.3g} m/s: the "
             "stop never ended; its distance, time and deceleration are of the part logged")
+
+
+def unconfirmed_locks(run: Run, rig: RigParameters) -> str | None:
+    """What says that the run's locks are not confirmed by the force (None: no lock, or the
+    force confirms it): a locked tyre slides, pulling μ = F_x/F_z at the curve's μ(λ = 1);
+    one that still grips at low slip pulls far less, and a wheel channel that stopped
+    reads 0 all the same (a stuck encoder had read as 9.5 s locked)."""
+    if run.lacks("vertical_load_n", "longitudinal_force_n"):
+        return None
+    window = braking_window(run)
+    vehicle, wheel = speeds_m_s(run, rig)
+    slip = slip_from(vehicle[window], wheel[window])
+    load = run.vertical_load_n[window]
+    locked = (slip >= LOCK_SLIP) & (vehicle[window] > LOCK_MIN_SPEED_M_S) & (load > MIN_LOAD_N)
+    if np.count_nonzero(locked) < MIN_BRAKING_SAMPLES:
+        return None
+    pulled = float(np.median(run.longitudinal_force_n[window][locked] / load[locked]))
+    sliding = float(friction_at(rig, np.ones(1))[0])
+    if abs(pulled / sliding - 1.0) <= LOCK_FRICTION_SHARE:
+        return None
+    duration = np.count_nonzero(locked) / run.rate_hz
+    return (f"{run.name}: {duration:.3g} s read as locked is unconfirmed: the tyre pulls "
+            f"μ {pulled:.3g} there, not the {sliding:.3g} of a sliding tyre (the curve's "
+            "μ(λ = 1)); wheel_speed_rad_s may have stopped reading (an encoder stuck at 0)")
 
 
 def _efficiency(rig: RigParameters, friction: np.ndarray, speed_m_s: np.ndarray,

@@ -310,3 +310,30 @@ def test_a_bag_without_the_flywheel_topic_reads_as_a_csv_without_that_column(tmp
     assert again.lacks("flywheel_speed_rad_s") == ("flywheel_speed_rad_s",)
     assert np.allclose(again.wheel_speed_rad_s, run.wheel_speed_rad_s, atol=1e-6)
     assert any("flywheel_speed_rad_s" in n and "not logged" in n for n in again.notes)
+
+
+@pytest.mark.parametrize("stuck", [True, False])
+def test_a_lock_the_force_does_not_confirm_is_said_unconfirmed(tmp_path, capsys, stuck):
+    """Item 4: a wheel encoder stuck at 0 after 2.5 s while the flywheel turned was read as
+    9.5 s locked. A locked tyre slides at the curve's mu(1); one that grips at low slip
+    pulls far less: the lock is said unconfirmed, the wheel channel suspected. A real lock
+    (58 bar, the wheel sliding) is not."""
+    path = tmp_path / "run.csv"
+    assert main(["simulate", "--pressure-bar", "20" if stuck else "58", "--no-plot", "-o",
+                 str(path)]) == 0
+    if stuck:
+        lines = path.read_text().splitlines()
+        at = CSV_COLUMNS.index("wheel_speed_rad_s")
+        rows = [line.split(",") for line in lines[1:]]
+        for row in rows:
+            if float(row[0]) > 2.5:
+                row[at] = "0"
+        path.write_text("\n".join([lines[0], *(",".join(r) for r in rows)]) + "\n")
+    capsys.readouterr()
+    assert main(["metrics", str(path)]) == 0
+    err = capsys.readouterr().err
+    said = [line for line in err.splitlines() if "unconfirmed" in line]
+    if stuck:
+        assert said and "wheel_speed_rad_s" in said[0] and "μ" in said[0], err
+    else:
+        assert not said, err

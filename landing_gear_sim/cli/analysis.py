@@ -237,7 +237,13 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
 
 
 def cmd_metrics(args: argparse.Namespace) -> int:
-    from antiskid.metrics import braking_metrics, metrics_table, stops, unfinished
+    from antiskid.metrics import (
+        braking_metrics,
+        metrics_table,
+        stops,
+        unconfirmed_locks,
+        unfinished,
+    )
     from landing_gear_sim.calibration.plausibility import check_units
     from landing_gear_sim.calibration.runs import classify_all
     from msg_tools.io import at_one_rate
@@ -249,7 +255,8 @@ def cmd_metrics(args: argparse.Namespace) -> int:
     # a unit within every range (a wheel in rpm: slip −7.8 accepted) named as identify does
     check_units(classify_all(parts), rig)
     rows = {part.name: braking_metrics(part, rig) for part in parts}
-    for note in filter(None, (unfinished(part, rig) for part in parts)):
+    for note in filter(None, (said(part, rig) for part in parts
+                              for said in (unfinished, unconfirmed_locks))):
         progress(f"note: {note}")
     print(metrics_table(rows))
     if len(parts) == 1:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import gzip
 import re
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -337,3 +338,60 @@ def test_a_lock_the_force_does_not_confirm_is_said_unconfirmed(tmp_path, capsys,
         assert said and "wheel_speed_rad_s" in said[0] and "μ" in said[0], err
     else:
         assert not said, err
+
+
+def _odd_logs(run: Run) -> dict[str, Callable[[Path], Path]]:
+    """The issue's classes of odd logs, each written into a folder as a user's file."""
+    def text(name: str, content: str | bytes) -> Callable[[Path], Path]:
+        def write(folder: Path) -> Path:
+            path = folder / name
+            if isinstance(content, bytes):
+                path.write_bytes(content)
+            else:
+                path.write_text(content)
+            return path
+        return write
+
+    whole = _csv(run)
+    lines = whole.splitlines()
+    at = CSV_COLUMNS.index("brake_pressure_bar")
+    return {
+        "cut and NUL-padded": text("run.csv", whole.encode()[:len(whole) // 2 - 3]
+                                   + b"\0" * 4096),
+        "two columns of one name": text("run.csv", "\n".join(
+            [lines[0] + ",brake_pressure_bar"]
+            + [f"{x},{0.6 * float(x.split(',')[at]):.6g}" for x in lines[1:]]) + "\n"),
+        "dead flywheel": text("run.csv", _csv(run, flywheel_speed_rad_s=0.0)),
+        "dead wheel": text("run.csv", _csv(run, wheel_speed_rad_s=0.0)),
+        "pressure of the wrong sign": text("run.csv", _csv(run, brake_pressure_bar=-1.0)),
+        "short": text("run.csv", "\n".join(lines[:16]) + "\n"),
+        "gzip under .csv": text("run.csv", gzip.compress(whole.encode())),
+        "time with 2 decimals": text("run.csv", _csv(run, time_format=".2f")),
+        "speeds in km/h": text("run.csv", _csv(run, wheel_speed_rad_s=3.6 * 0.3,
+                                               flywheel_speed_rad_s=3.6)),
+        "binary garbage": text("run.csv", b"\x00\x01garbage\x7f\n" * 10),
+        "empty": text("run.csv", ""),
+    }
+
+
+ODD = ("cut and NUL-padded", "two columns of one name", "dead flywheel", "dead wheel",
+       "pressure of the wrong sign", "short", "gzip under .csv", "time with 2 decimals",
+       "speeds in km/h", "binary garbage", "empty")
+
+
+@pytest.mark.parametrize("command", ["metrics", "convert", "validate"])
+@pytest.mark.parametrize("odd", ODD)
+def test_an_odd_log_ends_in_a_result_or_one_line_naming_its_file(tmp_path, run, capsys,
+                                                                  odd, command):
+    """The issue's numbers: 0 tracebacks, and every refusal one line naming the file (each
+    class's right answer is its own test above)."""
+    (tmp_path / "logs").mkdir()
+    path = _odd_logs(run)[odd](tmp_path / "logs")
+    argv = {"metrics": [str(path)], "convert": [str(path), str(tmp_path / "out.csv")],
+            "validate": [str(tmp_path / "logs"), "--report", str(tmp_path / "report")]}
+    code = main([command, *argv[command]])
+    err = capsys.readouterr().err
+    assert code in (0, 2) and "Traceback" not in err, (code, err)
+    if code == 2:
+        errors = [line for line in err.splitlines() if line.startswith("landing-gear-sim: err")]
+        assert len(errors) == 1 and ("run.csv" in errors[0] or "logs" in errors[0]), err

@@ -99,7 +99,8 @@ def _channels(table: Table, where: str, mapping: Mapping) -> dict[str, Channel]:
         found = ", ".join(table.columns) or "none"
         named = ", ".join(f"{column} for {contract}" for contract, column in missing)
         raise RunFormatError(f"{where}: missing column(s) {named} (found {found}); name "
-                             "them in a column-mapping file (an actuator-only log may leave "
+                             "them in a column-mapping file (--mapping FILE; "
+                             "docs/data-contract.md says how; an actuator-only log may leave "
                              "out all four wheel, flywheel and load channels; a braking log "
                              "its load cells or its flywheel encoder, not its time, current, "
                              "pressure or wheel speed)")

@@ -316,7 +316,8 @@ def find_header(above: list[str], dialect: Dialect, wanted: Sequence[str], where
         raise RunFormatError(f"{where}: no header row above the numbers (expected the "
                              f"columns {', '.join(wanted)})")
     raise RunFormatError(f"{where}: missing column(s) {', '.join(missing)} "
-                         f"(found {', '.join(found)}); name them in a column-mapping file")
+                         f"(found {', '.join(found)}); name them in a column-mapping file "
+                         "(--mapping FILE; docs/data-contract.md says how)")
 
 
 def _name(cell: str) -> str:

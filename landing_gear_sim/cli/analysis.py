@@ -74,6 +74,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     diag.add_argument("-o", "--output", type=Path, help="write the extended model (params)")
     diag.add_argument("--mapping", type=InputPath, help="column-mapping file for the CSVs")
     diag.set_defaults(func=cmd_diagnose)
+    plain_help = diag.format_help
+    diag.format_help = lambda: plain_help() + "\n" + _diagnose_kinds()
 
     met = sub.add_parser("metrics", help="braking metrics of a run (efficiency, locks, ...)")
     met.add_argument("run", type=InputPath, help="CSV or bag of a braking run")
@@ -193,6 +195,26 @@ def cmd_compare(args: argparse.Namespace) -> int:
     return 0
 
 
+def _diagnose_kinds() -> str:
+    """What a verdict can be and what a diagnosis may start without, for diagnose's help
+    (from the catalogue and the families' registry, read only when the help is asked for:
+    they load the numerical stack)."""
+    import textwrap
+
+    from landing_gear_sim.diagnosis.catalogue import CATALOGUE
+    from landing_gear_sim.diagnosis.families import REGISTRY
+    from landing_gear_sim.diagnosis.start import REMOVABLE
+
+    families = dict.fromkeys(name for f in REGISTRY
+                             for name in (f.reports, *f.words, *(h.family for h in f.hidden)))
+    lines = [
+        "verdicts: a catalogue element (" + ", ".join(CATALOGUE) + "); discovered, with "
+        "its family (" + ", ".join(families) + "); unexplained (the equation the evidence "
+        "lives in); none; inconclusive (what the campaign cannot test, and what would)",
+        "--without elements: " + ", ".join(REMOVABLE)]
+    return "\n".join(textwrap.fill(line, 79, subsequent_indent="  ") for line in lines) + "\n"
+
+
 def _names(text: str) -> list[str]:
     """One ``--without`` value: a name or a comma-separated list (a value per option, so
     that the option never takes the campaign after it for an element)."""
@@ -278,7 +300,7 @@ def cmd_antiskid(args: argparse.Namespace) -> int:
         make_controller,
         with_surface,
     )
-    from antiskid.metrics import braking_metrics, metrics_table
+    from antiskid.metrics import braking_metrics, efficiency_against_distance, metrics_table
     from msg_tools.csv_io import write_csv
 
     check_outputs(files=[args.output, args.json, args.plot])
@@ -295,6 +317,8 @@ def cmd_antiskid(args: argparse.Namespace) -> int:
     rows = {run.name: metrics,
             f"constant {pressure / PA_PER_BAR:.1f} bar": braking_metrics(baseline.to_run(), rig)}
     print(metrics_table(rows))
+    if (why := efficiency_against_distance(rows)) is not None:
+        print(why)
     if metrics.cycling_near_gear_walk:
         print(f"WARNING: pressure cycles at {metrics.cycling_frequency_hz:.1f} Hz, near the "
               f"gear-walk resonance ({metrics.gear_walk_frequency_hz:.1f} Hz)")

@@ -236,3 +236,34 @@ def test_the_extended_model_file_writes_its_law_in_engineering_units_and_loads_b
     assert main(["params", "--config", str(path)]) == 0
     [row] = [r for r in capsys.readouterr().out.splitlines() if r.startswith("wheel.term_1_code")]
     assert "[P > 0.5 bar]" in row
+
+
+def test_one_number_reads_one_value_on_the_page_and_in_the_terminal(reference, tmp_path):
+    """Issue 63, item 1: the verdict said delay = 6.003 ms while the candidates' table said
+    delay_s = 0.005994 (the first round's fit, before re-calibration), and the terminal
+    printed dBIC +78 where the page printed +79 for the same candidate. A candidate's row
+    shows the final value in engineering units, the first round's only where it differs,
+    labelled; ΔBIC and gains read the same everywhere."""
+    from landing_gear_sim.diagnosis.diagnose import Diagnosis
+    from landing_gear_sim.diagnosis.findings import Finding
+    from landing_gear_sim.report.diagnosis import diagnosis_sections, diagnosis_summary
+
+    def finding(value: float, round_: int) -> Finding:
+        return Finding(cause="actuator_delay", parameters={"delay_s": value},
+                       std={"delay_s": 0.00029}, evidence="", fit_before={"pressure_pa": 97.0},
+                       fit_after={"pressure_pa": 98.5}, delta_bic=-78.5, held_out=-1260.5,
+                       accepted=True, round=round_)
+
+    result = Diagnosis(verdict="actuator_delay", findings=[finding(0.006003, 0)],
+                       candidates=[finding(0.005994, 1)], baseline={}, start=reference,
+                       calibrated=reference, extended=reference, signatures_before=[],
+                       signatures_after=[])
+    page = html.unescape(" ".join(body for _, body in diagnosis_sections(result, tmp_path)))
+    terminal = diagnosis_summary(result)
+    row = re.search(r"<td>1</td><td>actuator_delay</td>.*?</tr>", page, re.S)
+    assert row and "6.003 ± 0.29 ms" in row.group(0), page
+    assert "(first round delay = 5.994 ms)" in row.group(0), page
+    assert "0.005994" not in page
+    for number in ("-78", "+1260"):
+        assert number in terminal and number in page, (number, terminal)
+    assert "-78.5" not in page and "+1260.5" not in page

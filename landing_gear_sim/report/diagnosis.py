@@ -29,7 +29,12 @@ from landing_gear_sim.report.figures import DISPLAY_UNITS, save_figure
 from landing_gear_sim.report.first_screen import first_figure
 from landing_gear_sim.report.local import local_gain_section
 from landing_gear_sim.report.pages import html_image, html_table, text_table, write_html
-from landing_gear_sim.report.words import headline, parameters_text, verdict_text
+from landing_gear_sim.report.words import (
+    candidate_values,
+    headline,
+    parameters_text,
+    verdict_text,
+)
 from msg_tools.run import Run
 from msg_tools.units import display
 
@@ -127,7 +132,7 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
         ["round", "cause", "accepted", "why", "key parameters", "ΔBIC", "held-out improvement",
          "fitted on", "checked on"],
         [[str(f.round or "discovery"), f.cause, "yes" if f.accepted else "no", f.reason,
-          ", ".join(f"{k} = {v:.4g}" for k, v in f.parameters.items()), _text(f.delta_bic),
+          candidate_values(f, result.findings), _text(f.delta_bic),
           _text(_gain(f.held_out)), ", ".join(f.fitted_on), ", ".join(f.checked_on)]
          for f in result.candidates])
     figure = first_figure(result, folder)
@@ -305,7 +310,9 @@ def _datasheet(params: RigParameters) -> str:
 
 
 def _text(value: float | None) -> str:
-    return "-" if value is None else f"{value:+.1f}"
+    """A ΔBIC or a held-out gain, as every table and the terminal write it (the terminal's
+    +78 had been the page's +79)."""
+    return "-" if value is None else f"{value:+.0f}"
 
 
 def _gain(held_out: float | None) -> float | None:
@@ -316,7 +323,7 @@ def _gain(held_out: float | None) -> float | None:
 def diagnosis_summary(result: Diagnosis) -> str:
     """The terminal summary: candidates, baseline fit, verdict, findings, notes."""
     rows = [[str(f.round or "disc."), f.cause, "yes" if f.accepted else "no",
-             _maybe(f.delta_bic), _maybe(_gain(f.held_out)),
+             _text(f.delta_bic), _text(_gain(f.held_out)),
              f"{_fits(f.fit_before)} -> {_fits(f.fit_after)}", f.reason]
             for f in result.candidates]
     lines = ["candidates:", text_table(["round", "cause", "accepted", "dBIC", "held-out gain",
@@ -353,7 +360,3 @@ def diagnosis_summary(result: Diagnosis) -> str:
 
 def _fits(values: dict[str, float]) -> str:
     return ", ".join(f"{c.split('_')[0]} {v:.1f}" for c, v in values.items())
-
-
-def _maybe(value: float | None) -> str:
-    return "-" if value is None else f"{value:+.0f}"

@@ -5,6 +5,7 @@ tables, for whoever checks the rule)."""
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 
 from landing_gear_sim.calibration.measured import CHANNELS
 from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
@@ -77,6 +78,22 @@ def parameters_text(finding: Finding) -> str:
     """``finding``'s parameters, each ``name = value ± σ`` in engineering units."""
     return ", ".join(parameter_text(k, v, finding.std.get(k), finding.units.get(k))
                      for k, v in finding.parameters.items())
+
+
+def candidate_values(candidate: Finding, findings: Sequence[Finding]) -> str:
+    """A candidate's parameters as the verdict states them: the final values of the finding
+    it became (re-calibrated after its round), and its round's own only where they differ,
+    labelled (the candidates' table had shown delay_s = 0.005994 beside a verdict of
+    6.003 ms)."""
+    final = next((f for f in findings if f.cause == candidate.cause
+                  and f.family == candidate.family
+                  and set(f.parameters) == set(candidate.parameters)), None)
+    shown = parameters_text(final or candidate)
+    if final is None or final.parameters == candidate.parameters:
+        return shown
+    first = ", ".join(parameter_text(k, v, None, candidate.units.get(k))
+                      for k, v in candidate.parameters.items())
+    return f"{shown} (first round {first})"
 
 
 def finding_sentence(finding: Finding, verdict: str, gain: bool = True) -> str:

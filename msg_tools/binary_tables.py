@@ -10,6 +10,7 @@ file is read, with a one-line hint when it is missing.
 from __future__ import annotations
 
 import importlib
+import warnings
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from types import ModuleType
@@ -56,7 +57,9 @@ def read_mat(path: Path) -> Table:
     import scipy.io
 
     try:
-        content = scipy.io.loadmat(path, squeeze_me=True, struct_as_record=False)
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always", scipy.io.matlab.MatReadWarning)
+            content = scipy.io.loadmat(path, squeeze_me=True, struct_as_record=False)
     except NotImplementedError:  # v7.3
         return read_hdf5(path)
     except Exception as exc:  # scipy raises many types for damaged files
@@ -72,7 +75,13 @@ def read_mat(path: Path) -> Table:
             named += [(f"{name}.{f}", getattr(value, f)) for f in fields]
         else:
             named.append((name, value))
-    return _vectors(named)
+    # what scipy warned of reading it is the run's note, not a line on the user's terminal
+    notes = tuple(f"{path}: {w.message}" for w in said
+                  if issubclass(w.category, scipy.io.matlab.MatReadWarning))
+    for w in said:  # any other warning as it came
+        if not issubclass(w.category, scipy.io.matlab.MatReadWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return _vectors(named, notes=notes)
 
 
 def read_hdf5(path: Path) -> Table:

@@ -76,7 +76,11 @@ class Check:
 
     @property
     def z(self) -> float:
-        return abs(self.deviation) / self.std if self.std > 0 else math.inf
+        """The deviation over its σ (0 ± 0, a channel that never moved, is none: it had read
+        as infinite σ)."""
+        if self.std > 0:
+            return abs(self.deviation) / self.std
+        return 0.0 if self.deviation == 0.0 else math.inf
 
     @property
     def violated(self) -> bool:

@@ -311,3 +311,25 @@ def test_identify_says_a_delay_the_model_lacks_and_what_it_costs_the_valves_dyna
     late_ms = float(note.split(" ms later than A(s)")[0].split()[-1])
     assert late_ms == pytest.approx(1e3 * truth[K.ACTUATOR_DELAY_S], rel=0.15), note
     assert "actuator_delay" in note and "diagnose" in note
+
+
+def test_a_step_log_of_another_valve_without_a_datasheet_takes_its_map_from_the_holds(
+        tmp_path, reference, capsys):
+    """Issue 64: a real valve's step log read without a datasheet was refused with
+    'brake_pressure_bar is 0.154 times what the valve map gives for its current; check its
+    unit'. 0.154 is no unit's factor: another valve, whose map the log's held levels give,
+    and a note says so."""
+    from landing_gear_sim.cli import main
+
+    share = float(np.random.default_rng(64).uniform(0.12, 0.2))  # drawn here
+    rig = reference.replace({**NOISE, K.ACTUATOR_MAP_K1_PA_PER_A:
+                             share * reference.number(K.ACTUATOR_MAP_K1_PA_PER_A),
+                             K.ACTUATOR_MAP_K2_PA_PER_A2:
+                             share * reference.number(K.ACTUATOR_MAP_K2_PA_PER_A2)}, "valve")
+    folder = _step_log(rig, tmp_path / "logs", 3, 64)
+    assert main(["identify", str(folder), "--partial", "-o", str(tmp_path / "valve.yaml")]) == 0
+    said = "".join(capsys.readouterr())
+    assert "held levels of the step log" in said and "another valve" in said, said
+    calibrated = load_parameters([tmp_path / "valve.yaml"], over_reference=True)
+    assert calibrated.number(K.ACTUATOR_MAP_K1_PA_PER_A) == pytest.approx(
+        rig.number(K.ACTUATOR_MAP_K1_PA_PER_A), rel=0.05)

@@ -20,7 +20,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.calibration.runs import ClassifiedRun, RunKind
 from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.actuator import actuator_pressure
@@ -61,7 +61,8 @@ def unit_notes(runs: Sequence[ClassifiedRun], params: RigParameters) -> list[str
     a clipping pressure transducer, a counted wheel channel and its resolution (each a
     note; empty: nothing)."""
     return [note for note in (_absolute_pressure(runs), _clipped_pressure(runs, params),
-                              _counted_wheel(runs), _other_load(runs, params)) if note]
+                              _counted_wheel(runs), _other_load(runs, params),
+                              _other_valve(runs, params)) if note]
 
 
 def _absolute_pressure(runs: Sequence[ClassifiedRun]) -> str | None:
@@ -280,15 +281,42 @@ def _near(value: float, factor: float) -> bool:
     return abs(value / factor - 1) < MATCH
 
 
-def _check_pressure(run: ClassifiedRun, params: RigParameters) -> None:
+def _pressure_ratio(run: ClassifiedRun, params: RigParameters) -> float | None:
+    """The measured pressure over what the datasheet's valve map gives for the run's
+    current, where the map is clear of its dead-band (None: too few such samples)."""
     expected = actuator_pressure(params, run.current_a, run.rate_hz)
     clear = expected > VALVE_PRESSURE_PA
     if clear.sum() < MIN_BRAKING_SAMPLES:
+        return None
+    return float(np.median(run.pressure_pa[clear]) / np.median(expected[clear]))
+
+
+def _check_pressure(run: ClassifiedRun, params: RigParameters) -> None:
+    ratio = _pressure_ratio(run, params)
+    if ratio is None or PLAUSIBLE_RATIO[0] <= ratio <= PLAUSIBLE_RATIO[1]:
         return
-    ratio = float(np.median(run.pressure_pa[clear]) / np.median(expected[clear]))
-    if not PLAUSIBLE_RATIO[0] <= ratio <= PLAUSIBLE_RATIO[1]:
-        _refuse(run, "brake_pressure_bar", ratio, "what the valve map gives for its current",
-                _likely(ratio, "pressure", "bar"))
+    unit = _likely(ratio, "pressure", "bar")
+    if unit is None and not run.braking and ratio > 0:
+        return  # no unit's factor: another valve, whose map its runs give (_other_valve)
+    _refuse(run, "brake_pressure_bar", ratio, "what the valve map gives for its current", unit)
+
+
+def _other_valve(runs: Sequence[ClassifiedRun], params: RigParameters) -> str | None:
+    """What says that the actuator runs' valve is not the datasheet's (a pressure no unit's
+    factor off its map: a real valve's step log had been refused as 0.154 times the map;
+    the calibration takes the map from the runs)."""
+    for run in runs:
+        ratio = None if run.braking else _pressure_ratio(run, params)
+        if ratio is None or PLAUSIBLE_RATIO[0] <= ratio <= PLAUSIBLE_RATIO[1] \
+                or _likely(ratio, "pressure", "bar") is not None or ratio <= 0:
+            continue
+        source = ("the quasi-static ramp" if any(r.kind is RunKind.ACTUATOR_RAMP for r in runs)
+                  else "the held levels of the step log")
+        return (f"{run.source or run.name}: brake_pressure_bar is {ratio:.3g} times what the "
+                "datasheet's valve map gives for its current, no unit's factor: another valve "
+                f"than the datasheet's; its map is calibrated from {source} (give its "
+                "datasheet with --config to start from it)")
+    return None
 
 
 EDGE_SAMPLES = 20  # a speed at a stop's start or end: the mean of this many samples

@@ -333,3 +333,30 @@ def test_a_step_log_of_another_valve_without_a_datasheet_takes_its_map_from_the_
     calibrated = load_parameters([tmp_path / "valve.yaml"], over_reference=True)
     assert calibrated.number(K.ACTUATOR_MAP_K1_PA_PER_A) == pytest.approx(
         rig.number(K.ACTUATOR_MAP_K1_PA_PER_A), rel=0.05)
+
+
+def test_a_datasheet_parameter_at_zero_does_not_end_the_diagnosis(tmp_path, capsys):
+    """Issue 64: a datasheet naming the valve with a dead-band of 0 ended the diagnosis at
+    'fitting a discovered term: valve' with "parameter 'actuator.deadband_current_a' must be
+    finite, got nan", exit 2: a free parameter at 0 had a window of 0.5-2 times 0, and the
+    fit's unit box divided by its width."""
+    from landing_gear_sim.cli import main
+
+    sheet = {"actuator": {"deadband_current_a": 0.0, "map_k1_pa_per_a": 9e5,
+                          "max_pressure_pa": 6e5, "natural_frequency_hz": 2.0,
+                          "damping_ratio": 0.9}, "elements": {"actuator_delay": True}}
+    (tmp_path / "sheet.yaml").write_text(yaml.safe_dump({"/**": {"ros__parameters": sheet}}))
+    datasheet = load_parameters([tmp_path / "sheet.yaml"], over_reference=True)
+    rng = np.random.default_rng(641)
+    release = rng.uniform(2.0, 4.0)  # the exhaust this many times as fast as the inlet
+    by_port = basis.product_code(basis.factor_code(basis.VALVE_ERROR, basis.SIGN),
+                                 basis.factor_code(basis.VALVE_ERROR, basis.IDENTITY))
+    rig = datasheet.replace({**NOISE, K.ACTUATOR_NATURAL_FREQUENCY_HZ: 3.0,
+                             K.ACTUATOR_MAP_K1_PA_PER_A: 9.5e5,
+                             K.ACTUATOR_DELAY_S: rng.uniform(0.05, 0.12),
+                             K.VALVE_TERMS[0][0]: float(by_port),
+                             K.VALVE_TERMS[0][1]: (1 - release ** 2) / (1 + release ** 2)},
+                            "the rig")
+    folder = _step_log(rig, tmp_path / "logs", 1, 641)
+    assert main(["diagnose", str(folder), "--config", str(tmp_path / "sheet.yaml")]) == 0, \
+        capsys.readouterr().err

@@ -295,7 +295,10 @@ def _problem(candidate: Candidate, chosen: Sequence[ClassifiedRun], base: RigPar
     keys within their bounds, the free ones within half and twice the ``references``'."""
     own = () if null else candidate.keys
     model = base if null else switched_on(candidate, base)
-    free = [k for k in candidate.free if k not in candidate.keys]
+    # a free parameter at 0 in every reference has no window of 0.5-2 times it: it stays
+    # (a valve's dead-band of 0 had ended a diagnosis on a nan from the window's width)
+    free = [k for k in candidate.free if k not in candidate.keys
+            and any(r.number(k) != 0.0 for r in references)]
     own_bounds = candidate.bounds if own else ()
     lower = np.array([b[0] for b in own_bounds]
                      + [0.5 * min(r.number(k) for r in references) for k in free])

@@ -264,6 +264,5 @@ def test_one_number_reads_one_value_on_the_page_and_in_the_terminal(reference, t
     assert row and "6.003 ± 0.29 ms" in row.group(0), page
     assert "(first round delay = 5.994 ms)" in row.group(0), page
     assert "0.005994" not in page
-    for number in ("-78", "+1260"):
+    for number in ("-78.5", "+1260.5"):
         assert number in terminal and number in page, (number, terminal)
-    assert "-78.5" not in page and "+1260.5" not in page

@@ -310,9 +310,9 @@ def _datasheet(params: RigParameters) -> str:
 
 
 def _text(value: float | None) -> str:
-    """A ΔBIC or a held-out gain, as every table and the terminal write it (the terminal's
-    +78 had been the page's +79)."""
-    return "-" if value is None else f"{value:+.0f}"
+    """A ΔBIC or a held-out gain, as every table and the terminal write it, to the tenth
+    the JSON's reader checks (the terminal's +78 had been the page's +79)."""
+    return "-" if value is None else f"{value:+.1f}"
 
 
 def _gain(held_out: float | None) -> float | None:

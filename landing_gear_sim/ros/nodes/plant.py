@@ -61,6 +61,9 @@ from msg_tools.units import PA_PER_BAR
 
 ACTUATOR, LOADING = "actuator", "loading_device"
 LOST_CHUNK = 500  # steps per watchdog tick once every input is lost: keep the executor responsive
+DISCOVERY_GRACE_S = 1.0  # linked this long before a start: another run's nodes are seen
+# by then (under load a second rig had matched its own three nodes before discovery showed it
+# the first run's, and started beside it)
 
 
 class PlantNode(GraphNode):
@@ -100,6 +103,7 @@ class PlantNode(GraphNode):
         self._ready: set[str] = set()
         self._heard = 0  # ready messages, of any session
         self._linked = self._started = self._done = False
+        self._linked_at = 0.0
         self._messages = _Messages()
         self._out = {topic: self.publisher(kind, topic) for topic, kind in (
             (TOPIC_CLOCK, Clock), (TOPIC_FLYWHEEL, JointState), (TOPIC_WHEEL, JointState),
@@ -146,12 +150,14 @@ class PlantNode(GraphNode):
 
     def _on_linked(self) -> None:
         self._linked = True
+        self._linked_at = time.monotonic()
         self._maybe_start()
 
     def _maybe_start(self) -> None:
         # every node announcing on this namespace heard first: a node of another session
         # whose ready message came after this session's had let a second run start
         if (self._started or not self._linked or not self._participants <= self._ready
+                or time.monotonic() - self._linked_at < DISCOVERY_GRACE_S
                 or self.count_publishers(self._ready_topic) > self._heard
                 or outside_gaps(self, self._out)):
             return

@@ -31,6 +31,16 @@ if TYPE_CHECKING:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the sub-commands of this module to the ``landing-gear-sim`` parser."""
+    _add_identify(sub)
+    _add_validate(sub)
+    _add_compare(sub)
+    _add_diagnose(sub)
+    _add_metrics(sub)
+    _add_antiskid(sub)
+
+
+def _add_identify(sub: argparse._SubParsersAction) -> None:
+    """``identify``: calibrate the model on a campaign."""
     ident = sub.add_parser("identify", help="calibrate the model on a campaign folder")
     ident.add_argument("campaign", type=InputPath, help="folder of runs (CSV files, bags)")
     add_params_arguments(ident)
@@ -43,6 +53,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "was skipped or failed (the file lists what kept its base value)")
     ident.set_defaults(func=cmd_identify)
 
+
+def _add_validate(sub: argparse._SubParsersAction) -> None:
+    """``validate``: a campaign simulated with its inputs, its fit report."""
     val = sub.add_parser("validate", help="simulate a campaign with its inputs; fit report")
     val.add_argument("campaign", type=InputPath, help="folder of runs (CSV files, bags)")
     add_params_arguments(val)
@@ -51,6 +64,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     val.add_argument("--mapping", type=InputPath, help="column-mapping file for the CSVs")
     val.set_defaults(func=cmd_validate)
 
+
+def _add_compare(sub: argparse._SubParsersAction) -> None:
+    """``compare``: one simulated run against one measured."""
     cmp_ = sub.add_parser("compare", help="fit per channel of a simulated vs a measured run")
     cmp_.add_argument("measured", type=InputPath, help="the rig's run (CSV or bag)")
     cmp_.add_argument("simulated", type=InputPath, help="the model's run of the same input")
@@ -60,6 +76,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_params_arguments(cmp_, without=False)  # the rig MEASURED comes from: its units checked
     cmp_.set_defaults(func=cmd_compare)
 
+
+def _add_diagnose(sub: argparse._SubParsersAction) -> None:
+    """``diagnose``: why model and rig disagree (its help lists the verdicts)."""
     diag = sub.add_parser("diagnose", help="why model and rig disagree: cause, extension, gain")
     diag.add_argument("runs", type=InputPath, nargs="+", metavar="RUN",
                       help="CSV files, bags, or campaign folders")
@@ -77,6 +96,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     plain_help = diag.format_help
     diag.format_help = lambda: plain_help() + "\n" + _diagnose_kinds()
 
+
+def _add_metrics(sub: argparse._SubParsersAction) -> None:
+    """``metrics``: braking metrics of one run."""
     met = sub.add_parser("metrics", help="braking metrics of a run (efficiency, locks, ...)")
     met.add_argument("run", type=InputPath, help="CSV or bag of a braking run")
     add_params_arguments(met)
@@ -85,6 +107,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     met.add_argument("--json", type=Path, help="write the metrics as JSON")
     met.set_defaults(func=cmd_metrics)
 
+
+def _add_antiskid(sub: argparse._SubParsersAction) -> None:
+    """``antiskid``: a controller against the rig model, offline."""
     anti = sub.add_parser("antiskid", help="an anti-skid controller against the rig model, "
                           "offline; metrics against a constant-pressure stop")
     anti.add_argument("--controller", choices=["threshold", "slip"], default="threshold",

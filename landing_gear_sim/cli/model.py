@@ -34,6 +34,17 @@ if TYPE_CHECKING:
 
 def register(sub: argparse._SubParsersAction) -> None:
     """Add the sub-commands of this module to the ``landing-gear-sim`` parser."""
+    _add_simulate(sub)
+    _add_rig(sub)
+    _add_bode(sub)
+    _add_params(sub)
+    _add_campaign(sub)
+    _add_convert(sub)
+    _add_join(sub)
+
+
+def _add_simulate(sub: argparse._SubParsersAction) -> None:
+    """``simulate``: one rig test, offline."""
     sim = sub.add_parser("simulate", help="simulate a rig test; write CSV (+ bag) and a plot")
     add_params_arguments(sim)
     add_run_arguments(sim)
@@ -45,6 +56,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     sim.add_argument("--no-plot", action="store_true", help="write no PNG")
     sim.set_defaults(func=cmd_simulate)
 
+
+def _add_rig(sub: argparse._SubParsersAction) -> None:
+    """``rig``: the ROS 2 node graph up for one run."""
     rig = sub.add_parser("rig", help="bring the ROS 2 node graph up for one run; record a bag")
     add_params_arguments(rig)
     add_run_arguments(rig)
@@ -55,6 +69,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_graph_arguments(rig)  # the launch file's arguments too
     rig.set_defaults(func=cmd_rig, launcher=True)
 
+
+def _add_bode(sub: argparse._SubParsersAction) -> None:
+    """``bode``: the frequency responses of paper Fig. 7."""
     bode = sub.add_parser("bode", help="frequency responses G_lambda, G_eta (paper Fig. 7)")
     add_params_arguments(bode)
     bode.add_argument("--speeds", type=float, nargs="+", default=[10.0, 30.0, 60.0],
@@ -67,11 +84,17 @@ def register(sub: argparse._SubParsersAction) -> None:
                       help="PNG path (default out/bode.png)")
     bode.set_defaults(func=cmd_bode)
 
+
+def _add_params(sub: argparse._SubParsersAction) -> None:
+    """``params``: the effective parameter set, shown or written."""
     show = sub.add_parser("params", help="show (or write) the effective parameter set")
     add_params_arguments(show)
     show.add_argument("--write", type=Path, help="write the merged set as a params file")
     show.set_defaults(func=cmd_params)
 
+
+def _add_campaign(sub: argparse._SubParsersAction) -> None:
+    """``campaign``: a synthetic campaign of the own generator."""
     gen = sub.add_parser("campaign", help="generate a synthetic rig campaign (own generator)")
     gen.add_argument("output", type=Path, help="new folder for the runs")
     add_params_arguments(gen)
@@ -89,6 +112,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                           "what shows a tyre's friction changing with the load")
     gen.set_defaults(func=cmd_campaign)
 
+
+def _add_convert(sub: argparse._SubParsersAction) -> None:
+    """``convert``: a run from one format into another."""
     conv = sub.add_parser("convert", help="convert a run between CSV and rosbag2")
     conv.add_argument("input", type=InputPath, help="a run: CSV, bag folder or another format")
     conv.add_argument("output", type=Path, help="*.csv, *.txt, *.tsv (any case), or a "
@@ -97,6 +123,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     conv.add_argument("--mapping", type=InputPath, help="column-mapping file for a CSV input")
     conv.set_defaults(func=cmd_convert)
 
+
+def _add_join(sub: argparse._SubParsersAction) -> None:
+    """``join``: a recorded bag's segments into one file."""
     join = sub.add_parser("join", help="join a recorded bag's segments into one storage file "
                                        "(a long recording stopped by a signal keeps them)")
     join.add_argument("bag", type=InputPath, help="a bag folder")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -123,10 +124,11 @@ def _without_copies(found: list[Path], skipped: list[str]) -> list[Path]:
     """``found`` without files byte-identical to one before them, each said in ``skipped``
     (a copy under another name had been counted as one more run, and held out)."""
     sizes = [p.stat().st_size if p.is_file() else -1 for p in found]
+    shared = Counter(sizes)
     kept: list[Path] = []
     first: dict[tuple[int, str], Path] = {}
     for path, size in zip(found, sizes, strict=True):
-        if size < 0 or sizes.count(size) == 1:  # a folder, or no file of its size
+        if size < 0 or shared[size] == 1:  # a folder, or no file of its size
             kept.append(path)
             continue
         key = (size, _digest(path))

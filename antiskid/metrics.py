@@ -27,7 +27,7 @@ from landing_gear_sim.model.quantities import (
     rolling_radius_at,
 )
 from landing_gear_sim.model.scenario import BRAKE_ON_CURRENT_A, brake_start_index
-from msg_tools.checks import MIN_BRAKING_SAMPLES
+from msg_tools.checks import MIN_BRAKING_SAMPLES, too_short
 from msg_tools.run import Run
 from msg_tools.units import PA_PER_BAR
 
@@ -68,12 +68,8 @@ class BrakingMetrics:
 
 def braking_window(run: Run) -> slice:
     """From the first brake command (scenario.brake_start_index) to the end of the run."""
-    if len(run) < MIN_BRAKING_SAMPLES:
-        # a short table reads; it is no stop (it had been refused as 'no table of numbers')
-        raise LandingGearSimError(
-            f"{run.source or run.name}: the table holds only {len(run)} rows "
-            f"({run.time_s[-1] - run.time_s[0]:.3g} s): a stop's metrics need at least "
-            f"{MIN_BRAKING_SAMPLES} rows while braking, from before the brake to the stop")
+    if (short := too_short(run, "a stop's metrics")) is not None:
+        raise LandingGearSimError(short)
     start = brake_start_index(run.current_a, run.rate_hz)
     lacking = run.lacks("flywheel_speed_rad_s")
     if lacking:
@@ -231,8 +227,6 @@ def metrics_table(rows: dict[str, BrakingMetrics]) -> str:
                      f"{m.mean_deceleration_m_s2:12.2f} {m.slip_rms:8.3f} {m.slip_max:8.3f} "
                      f"{m.lock_events:5d} {m.cycling_frequency_hz:12.2f}")
     return "\n".join(lines)
-
-
 
 
 def efficiency_against_distance(rows: dict[str, BrakingMetrics]) -> str | None:

@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from .errors import RunFormatError
+from .run import Run
 from .units import PA_PER_BAR
 
 PLAUSIBLE_MAX: dict[str, tuple[float, str, float]] = {
@@ -39,6 +40,17 @@ def check_plausible(fields: dict[str, np.ndarray], where: str) -> None:
                 "column-mapping file")
     check_time(fields["time_s"], where)
     check_signs(fields, where)
+
+
+def too_short(run: Run, what: str) -> str | None:
+    """Why ``run`` is too short for ``what`` (a plural: 'a stop's metrics'), or None: fewer
+    than MIN_BRAKING_SAMPLES rows read as a table but are no stop (a 15-row file had been
+    'no table of numbers', then a traceback in a zero-phase filter)."""
+    if len(run) >= MIN_BRAKING_SAMPLES:
+        return None
+    return (f"{run.source or run.name}: the table holds only {len(run)} rows "
+            f"({run.time_s[-1] - run.time_s[0]:.3g} s): {what} need at least "
+            f"{MIN_BRAKING_SAMPLES} rows while braking, from before the brake to the stop")
 
 
 REPEATED_SHARE = 0.1  # of the steps zero: the time's digits, not a duplicated sample

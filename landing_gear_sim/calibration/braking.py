@@ -33,7 +33,7 @@ from landing_gear_sim.model.elements import (
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import rim_speed_m_s, rolling_radius_at
 from landing_gear_sim.model.sensors import SensorModel
-from msg_tools.checks import MIN_BRAKING_SAMPLES
+from msg_tools.checks import too_short
 from msg_tools.units import PA_PER_BAR
 
 FILTER_HZ = 20.0  # zero-phase low-pass before differentiating speeds
@@ -70,11 +70,8 @@ def lowpass(values: np.ndarray, rate_hz: float, cutoff_hz: float = FILTER_HZ) ->
 
 def prepare(run: ClassifiedRun, p: RigParameters) -> Braking:
     """The filtered signals of a braking run under the parameter set ``p``."""
-    if len(run) < MIN_BRAKING_SAMPLES:  # the zero-phase filter needs more (a traceback once)
-        raise IdentificationError(
-            f"{run.source or run.name}: the table holds only {len(run)} rows: a braking "
-            f"run's analysis needs at least {MIN_BRAKING_SAMPLES}, from before the brake to "
-            "the stop")
+    if (short := too_short(run, "a braking run's filters")) is not None:
+        raise IdentificationError(short)  # the zero-phase filter's padding (a traceback once)
     rate = run.rate_hz
     wheel = lowpass(run.wheel_speed_rad_s, rate)
     sensors = SensorModel.of(p)

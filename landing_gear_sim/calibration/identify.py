@@ -43,7 +43,7 @@ from landing_gear_sim.calibration.runs import (
 )
 from landing_gear_sim.calibration.statistics import Estimate
 from landing_gear_sim.errors import IdentificationError, ParameterError
-from landing_gear_sim.model.parameters import SPECS, RigParameters
+from landing_gear_sim.model.parameters import SPEC_BY_KEY, RigParameters
 from landing_gear_sim.processes import single_threaded_blas
 from msg_tools.run import Run
 
@@ -84,10 +84,8 @@ def _identified(estimate: Estimate) -> bool:
     quantity of one sign (a signed one, an offset or a slope, may be 0 within its σ)."""
     if not math.isfinite(estimate.std):
         return False
-    return SIGNED.get(estimate.key, True) or abs(estimate.std) <= abs(estimate.value)
-
-
-SIGNED = {spec.key: spec.signed for spec in SPECS}
+    spec = SPEC_BY_KEY.get(estimate.key)
+    return spec is None or spec.signed or abs(estimate.std) <= abs(estimate.value)
 
 
 class _Calibration:
@@ -107,9 +105,11 @@ class _Calibration:
         before its first step had written ω_n 10.4 ± 1.6e7 Hz into the params file).
         ``start``: estimates a later step refines, all taken (a friction fit's ϑ stuck on
         its bound is the refinement's business)."""
-        kept = [e for e in new if start or _identified(e)]
+        kept: list[Estimate] = []
         for e in new:
-            if e not in kept:
+            if start or _identified(e):
+                kept.append(e)
+            else:
                 self.problems.append(
                     f"{e.key}: the runs cannot identify it ({e.value:.4g} ± {e.std:.2g}); "
                     f"kept {self.params.number(e.key):.4g}, the value it had")

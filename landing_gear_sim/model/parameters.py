@@ -217,7 +217,8 @@ SPECS: tuple[ParamSpec, ...] = (
 
 INDEX: dict[str, int] = {spec.key: i for i, spec in enumerate(SPECS)}
 N_PARAMS: int = len(SPECS)
-_SPEC_BY_KEY: dict[str, ParamSpec] = {spec.key: spec for spec in SPECS}
+SPEC_BY_KEY: dict[str, ParamSpec] = {spec.key: spec for spec in SPECS}
+"""Each key's spec (its unit, bounds, whether it may be negative)."""
 _OWNED_SECTIONS: frozenset[str] = frozenset(key.split(".")[0] for key in INDEX)
 
 Value = float | bool | str
@@ -366,7 +367,7 @@ def read_params_file(path: Path) -> dict[str, Value]:
 
 def _as_ros_reads_it(key: str, value: Value) -> Value:
     """PyYAML (YAML 1.1) reads ``6.9e5`` as text; ROS's parser reads a double: follow ROS."""
-    if isinstance(value, str) and _SPEC_BY_KEY[key].kind == "float":
+    if isinstance(value, str) and SPEC_BY_KEY[key].kind == "float":
         try:
             return float(value)
         except ValueError:
@@ -380,7 +381,7 @@ def _one_line(exc: Exception) -> str:
 
 def _check_known(values: Iterable[str], source: str) -> None:
     for key in values:
-        if key not in _SPEC_BY_KEY:
+        if key not in SPEC_BY_KEY:
             hint = difflib.get_close_matches(key, INDEX, n=1)
             suggestion = f" (did you mean {hint[0]!r}?)" if hint else ""
             raise ParameterError(f"{source}: unknown parameter {key!r}{suggestion}")

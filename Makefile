@@ -53,6 +53,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/graph.py
 	$(BIN)/python bench/controllers.py
 	$(BIN)/python bench/diagnose.py
+	$(BIN)/python bench/sensitivity.py
 	$(BIN)/python bench/io.py
 	$(BIN)/python bench/montecarlo.py
 	$(BIN)/python bench/history.py

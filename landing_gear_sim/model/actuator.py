@@ -27,6 +27,7 @@ from numba import njit
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import elements as el
 from landing_gear_sim.model import keys as K
+from landing_gear_sim.model.dual_arrays import vector_like
 from landing_gear_sim.model.parameters import INDEX, RigParameters
 
 _ACT_GAIN = INDEX[K.ACTUATOR_GAIN]
@@ -116,7 +117,7 @@ def _matrices(natural_frequency_hz: float, damping_ratio: float, gain: float, de
 def actuator_state(matrices):
     """Zero actuator state: pressure, rate, the current the valve sees (after its play),
     then the static pressures of recent steps."""
-    return np.zeros(PLAY + 1 + int(matrices[ACT_DELAY_STEPS]) + 2)
+    return vector_like(matrices, PLAY + 1 + int(matrices[ACT_DELAY_STEPS]) + 2)
 
 
 @njit(cache=True)

@@ -19,6 +19,7 @@ from landing_gear_sim.model.actuator import (
     actuator_step,
     settled_state,
 )
+from landing_gear_sim.model.dual_arrays import rows_like, vector_like
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.plant import (
     CHANNELS,
@@ -45,11 +46,11 @@ def run_kernel(p, matrices, current, step_s, contact, initial_speed, stop_speed,
     ``angle``: the wheel's measured angle at each step (n,), which the plant's angle takes
     at every exchange, or empty: the plant's own. ``settled``: the valve starts settled on
     ``current[0]`` (else at rest, as a rig test starts)."""
-    x = np.zeros(N_STATES)
+    x = vector_like(p, N_STATES)
     x[SPEED] = initial_speed if contact else 0.0
     xa = settled_state(p, matrices, current[0]) if settled else actuator_state(matrices)
-    xl = np.zeros(1)
-    work = np.zeros((5, N_STATES))
+    xl = vector_like(p, 1)
+    work = rows_like(p, 5, N_STATES)
     pressure, load = xa[0], 0.0
     # a wheel off the ground at rest is a fixed point of the plant (every derivative is
     # exactly 0): stepping it only costs time (~80 % of an actuator run's simulation)

@@ -204,25 +204,33 @@ def test_a_pool_task_takes_the_cores_the_pools_other_tasks_leave(monkeypatch):
     assert processes.threads() == 1  # a worker of a pool that shares no count
 
 
-def _counting(monkeypatch) -> list[bytes]:
-    """The parameter sets the candidate fits simulate, in order, as bytes."""
+def _counting(monkeypatch) -> list[tuple[str, bytes]]:
+    """The parameter sets the candidate fits simulate, in order, as bytes, each with how:
+    "plain", or "dual" (its residual and its derivatives, in one pass)."""
     from landing_gear_sim.diagnosis import catalogue
 
-    simulated: list[bytes] = []
+    simulated: list[tuple[str, bytes]] = []
     original = catalogue.scaled_residuals
+    with_derivatives = catalogue.scaled_residuals_and_jacobian
 
     def counted(runs, trials, *args, **kwargs):
-        simulated.extend(t.vector().tobytes() for t in trials)
+        simulated.extend(("plain", t.vector().tobytes()) for t in trials)
         return original(runs, trials, *args, **kwargs)
 
+    def counted_with_derivatives(runs, trial, *args, **kwargs):
+        simulated.append(("dual", trial.vector().tobytes()))
+        return with_derivatives(runs, trial, *args, **kwargs)
+
     monkeypatch.setattr(catalogue, "scaled_residuals", counted)
+    monkeypatch.setattr(catalogue, "scaled_residuals_and_jacobian", counted_with_derivatives)
     return simulated
 
 
 def test_a_fit_simulates_its_start_once(reference, tmp_path, monkeypatch):
     """The starts are simulated to rank them; the optimiser then asked for the chosen one's
     residual again (and the final fit for the best probe's), a campaign simulation each for
-    nothing."""
+    nothing. A set is simulated plainly at most once, and with its derivatives (the dual
+    pass the plain one cannot stand for) at most once."""
     runs, _ = _hidden(reference, tmp_path, 26, lambda rng: {
         "elements.actuator_delay": True, "actuator.delay_s": 0.008}, ACTUATOR_RUNS)
     calibrated = identify(runs, reference).params
@@ -247,3 +255,20 @@ def test_a_candidate_tried_again_starts_where_it_ended(reference, tmp_path, monk
     assert again.values["actuator.delay_s"] == pytest.approx(first.values["actuator.delay_s"],
                                                              abs=1e-4)
     assert again.cost <= first.cost * (1 + 1e-3)
+
+
+def test_a_fit_that_stops_on_its_budget_says_so_in_the_candidates_reason(
+        reference, tmp_path, monkeypatch):
+    """Issue 61: a fit that ran out of evaluations ends where it stood, which need not be its
+    optimum; its candidate's reason says so."""
+    from landing_gear_sim.diagnosis import catalogue, scoring
+
+    runs, _ = _hidden(reference, tmp_path, 26, lambda rng: {
+        "elements.actuator_delay": True, "actuator.delay_s": 0.008}, ACTUATOR_RUNS)
+    calibrated = identify(runs, reference).params
+    assert not fit_candidate(CATALOGUE["actuator_delay"], runs, calibrated).stopped
+    monkeypatch.setattr(catalogue, "MAX_ITERATIONS", 2)
+    stopped = fit_candidate(CATALOGUE["actuator_delay"], runs, calibrated)
+    assert stopped.stopped
+    reason = scoring._reason("", stopped)
+    assert reason.startswith(scoring.ACCEPTED) and "budget of 2 evaluations" in reason

@@ -10,8 +10,8 @@ import numpy as np
 from scipy.optimize import OptimizeResult, least_squares
 
 from landing_gear_sim.calibration.braking import LOADED_N, Braking, hub_speed
-from landing_gear_sim.calibration.differences import Objective, side_by_side
-from landing_gear_sim.calibration.measured import simulate_run
+from landing_gear_sim.calibration.differences import Derivatives, Objective, side_by_side
+from landing_gear_sim.calibration.measured import simulate_run, simulate_run_with_sensitivities
 from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
 from landing_gear_sim.calibration.slots import Slot
 from landing_gear_sim.calibration.statistics import Estimate, covariance_std, run_weights
@@ -21,6 +21,7 @@ from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.elements import MIN_HUB_SPEED_M_S, burckhardt_mu, slip_ratio
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import friction_at, load_factor_at, rolling_radius_at
+from landing_gear_sim.processes import map_threads
 from msg_tools.run import Run
 
 KEYS = (K.FRICTION_THETA1, K.FRICTION_THETA2, K.FRICTION_THETA3)
@@ -160,12 +161,36 @@ def refine_friction(runs: Sequence[ClassifiedRun], p: RigParameters, jackknife: 
         simulated, _ = simulate_run(runs[i], trial)
         return weights[i] * slip_error(runs[i], simulated, windows[i], ratio)
 
+    def trial(theta: np.ndarray) -> RigParameters:
+        return p.replace(dict(zip(keys, theta * start, strict=True)), "identify")
+
     def residuals(thetas: Sequence[np.ndarray], chosen: Sequence[int]) -> list[np.ndarray]:
         # every (θ, run) simulated side by side: a Jacobian's columns share the cores
-        return side_by_side(error, [p.replace(dict(zip(keys, theta * start, strict=True)),
-                                              "identify") for theta in thetas], chosen)
+        return side_by_side(error, [trial(theta) for theta in thetas], chosen)
 
-    fit = _least_squares(lambda thetas: residuals(thetas, range(len(runs))), np.ones(3),
+    def derivatives(theta: np.ndarray, chosen: Sequence[int]
+                    ) -> tuple[np.ndarray, np.ndarray] | None:
+        params = trial(theta)
+        ratio = params.number(K.FLYWHEEL_RADIUS_M) / params.number(K.WHEEL_UNLOADED_RADIUS_M)
+
+        def one(i: int) -> tuple[np.ndarray, np.ndarray] | None:
+            found = simulate_run_with_sensitivities(runs[i], params, keys, list(start))
+            if found is None:
+                return None
+            simulated, d = found
+            slope = (d["wheel_speed_rad_s"] - ratio * d["flywheel_speed_rad_s"])[windows[i]]
+            return (weights[i] * slip_error(runs[i], simulated, windows[i], ratio),
+                    weights[i] * slope[::5] * start)
+
+        parts = map_threads(one, chosen)
+        if any(part is None for part in parts):
+            return None
+        return (np.concatenate([part[0] for part in parts if part is not None]),
+                np.concatenate([part[1] for part in parts if part is not None]))
+
+    every = range(len(runs))
+    fit = _least_squares(lambda thetas: residuals(thetas, every),
+                         lambda theta: derivatives(theta, every), np.ones(3),
                          REFINE_ITERATIONS)
     pinned = np.isclose(fit.x, REFINE_BOUNDS[0]) | np.isclose(fit.x, REFINE_BOUNDS[1])
     if np.any(pinned):
@@ -177,7 +202,7 @@ def refine_friction(runs: Sequence[ClassifiedRun], p: RigParameters, jackknife: 
             "slip: add oscillating runs, or keep ϑ3 with --fix-theta3)")
     std = covariance_std(fit, 3)
     if jackknife:
-        std = np.maximum(std, _jackknife_std(residuals, fit.x, len(runs)))
+        std = np.maximum(std, _jackknife_std(residuals, derivatives, fit.x, len(runs)))
     names = tuple(r.name for r in runs)
     method = "output error on wheel vs flywheel speed; σ: max(residual, jackknife)" + (
         f" (stopped at its budget of {REFINE_ITERATIONS} steps)" if fit.status == 0 else "")
@@ -186,24 +211,29 @@ def refine_friction(runs: Sequence[ClassifiedRun], p: RigParameters, jackknife: 
 
 
 def _least_squares(residuals: Callable[[Sequence[np.ndarray]], list[np.ndarray]],
-                   start: np.ndarray, iterations: int | None = None) -> OptimizeResult:
-    """The refinement's least squares within REFINE_BOUNDS, at most ``iterations`` steps."""
-    objective = Objective(residuals, *REFINE_BOUNDS)
+                   derivatives: Derivatives, start: np.ndarray, iterations: int | None = None
+                   ) -> OptimizeResult:
+    """The refinement's least squares within REFINE_BOUNDS, at most ``iterations`` steps
+    (on the plant's own derivatives where differences.MODEL_DERIVATIVES is on)."""
+    objective = Objective(residuals, *REFINE_BOUNDS, derivatives=derivatives)
     return least_squares(objective.fun, start, jac=objective.jac, bounds=REFINE_BOUNDS,
                          max_nfev=iterations)
 
 
 def _jackknife_std(residuals: Callable[[Sequence[np.ndarray], Sequence[int]],
                                        list[np.ndarray]],
+                   derivatives: Callable[[np.ndarray, Sequence[int]],
+                                         tuple[np.ndarray, np.ndarray] | None],
                    solution: np.ndarray, n_runs: int) -> np.ndarray:
     """Leave-one-run-out spread of the fit: run-to-run variability the residuals hide."""
     if n_runs < 3:
         return np.zeros_like(solution)
 
-    def leaving_out(i: int) -> Callable[[Sequence[np.ndarray]], list[np.ndarray]]:
+    def leaving_out(i: int) -> OptimizeResult:
         chosen = [j for j in range(n_runs) if j != i]
-        return lambda thetas: residuals(thetas, chosen)
+        return _least_squares(lambda thetas: residuals(thetas, chosen),
+                              lambda theta: derivatives(theta, chosen), solution)
 
-    fits = [_least_squares(leaving_out(i), solution).x for i in range(n_runs)]
+    fits = [leaving_out(i).x for i in range(n_runs)]
     spread = np.asarray(fits) - np.mean(fits, axis=0)
     return np.sqrt((n_runs - 1) / n_runs * np.sum(spread ** 2, axis=0))

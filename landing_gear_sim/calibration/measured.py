@@ -9,6 +9,7 @@ included): a comparison never carries random noise of the model's own.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -24,8 +25,10 @@ from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.elements import valve_static_pressure
 from landing_gear_sim.model.integrate import SimulationResult, simulate
 from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.plant import CHANNELS as PLANT_CHANNELS
 from landing_gear_sim.model.quantities import at_static_load, load_taken_at, rim_speed_m_s
 from landing_gear_sim.model.scenario import Scenario, logged_to_held
+from landing_gear_sim.model.sensitivity import simulate_with_sensitivities
 from landing_gear_sim.model.sensors import SensorModel
 from landing_gear_sim.processes import map_threads
 from msg_tools.run import Run
@@ -131,13 +134,34 @@ def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult
     :mod:`~landing_gear_sim.calibration.wheel_angle`).
     """
     run = classified(run)
+    setup = _setup(run, params)
+    result = simulate(setup.params, setup.scenario)
+    return _as_logged(run, result, setup.angle), result
+
+
+@dataclass(frozen=True)
+class _Setup:
+    """What a run is simulated with: the set (at the run's load, wear and phases), its
+    scenario, and the measured wheel angle its encoder ripples at (None: no ripple)."""
+
+    params: RigParameters
+    scenario: Scenario
+    angle: np.ndarray | None
+
+
+def _setup(run: ClassifiedRun, params: RigParameters) -> _Setup:
     params = _at_run_load(run_parameters(params, run.campaign_order), run)
     angle = followed = None
     if run.braking and SensorModel.of(params).ripples:
         params, angle = run_phases(params, run), measured_angle_rad(run)
     if run.braking and has_brake_runout(params):
         params, followed = brake_run_phases(params, run), measured_angle_rad(run)
-    result = simulate(params, scenario_for_run(run, params, followed))
+    return _Setup(params, scenario_for_run(run, params, followed), angle)
+
+
+def _as_logged(run: ClassifiedRun, result: SimulationResult, angle: np.ndarray | None) -> Run:
+    """The simulation as the run's logger reads it, on the run's samples (see
+    :func:`simulate_run`)."""
     simulated = result.to_run(
         wheel_angle_rad=None if angle is None else angle[:len(result.time_s)])
     n, m = len(run), len(simulated)
@@ -150,7 +174,82 @@ def simulate_run(run: Run, params: RigParameters) -> tuple[Run, SimulationResult
         fields = {name: np.where(lost, getattr(run, name), values)
                   for name, values in fields.items()}
     return Run(name=run.name, source="simulation", time_s=run.time_s,
-               current_a=run.current_a, **fields), result
+               current_a=run.current_a, **fields)
+
+
+def simulate_run_with_sensitivities(run: Run, params: RigParameters, keys: Sequence[str],
+                                    spans: Sequence[float] | None = None
+                                    ) -> tuple[Run, dict[str, np.ndarray]] | None:
+    """:func:`simulate_run`'s run and each channel's derivatives with respect to ``keys``,
+    (n, len(keys)) [the channel's unit per the key's], from one dual pass of the plant
+    (:mod:`~landing_gear_sim.model.sensitivity`); None where they would not be the whole
+    derivative: a run whose initial speed, or whose disc's phases, move with a key.
+
+    What the keys change before the plant (the run's load, its wear) and the logger's read
+    of the simulation (an offset, a channel out of step, a crosstalk, the valve's pressure
+    after a stop) are cheap array arithmetic beside the simulation, affine or smooth: their
+    part is a difference of that arithmetic alone, along the plant's derivatives and along
+    each key. ``spans``: each key's scale (a fit's window), which sets the differences' steps
+    where the key is at 0 (a slot's coefficient, an offset: a step of 1e-13 Pa was lost in
+    the rounding of a pressure); default the key's size, or 1.
+    """
+    run = classified(run)
+    keys = tuple(keys)
+    setup = _setup(run, params)
+    if run.braking and has_brake_runout(setup.params):
+        return None  # the phases are fitted on the run under the set: no cheap difference
+    steps = _steps(params, keys, spans)
+    moved = [_setup(run, params.replace({k: params.number(k) + h}, "derivative"))
+             for k, h in zip(keys, steps, strict=True)]
+    if any(m.scenario.initial_speed_m_s != setup.scenario.initial_speed_m_s
+           or m.scenario.settled_start != setup.scenario.settled_start for m in moved):
+        return None
+    base = setup.params.vector()
+    seeds = np.stack([(m.params.vector() - base) / h for m, h in zip(moved, steps,
+                                                                     strict=True)], axis=1)
+    found = simulate_with_sensitivities(setup.params, setup.scenario, keys, seeds)
+    logged = _as_logged(run, found.result, setup.angle)
+    derivatives = {c: np.empty((len(run), len(keys))) for c in CHANNELS}
+    for j, (m, h) in enumerate(zip(moved, steps, strict=True)):
+        along = _logged_along(run, found.result, logged, found.tangents[:, :, j], setup.angle)
+        own = _as_logged(run, replace(found.result, params=m.params), m.angle)
+        for c in CHANNELS:
+            derivatives[c][:, j] = along[c] + (getattr(own, c) - getattr(logged, c)) / h
+    return logged, derivatives
+
+
+_SETUP_STEP = 1e-7  # of a key's scale: the set-up and the logger are affine or smooth in it
+_DATA_STEP = 1e-7  # of the simulated channels' size, along their derivatives
+_READ = tuple(PLANT_CHANNELS.index(c) for c in ("pressure_pa", "wheel_speed_rad_s", "speed_m_s",
+                                                "vertical_load_n", "longitudinal_force_n"))
+"""The simulation's columns the logger reads (the flywheel's speed from the rim's)."""
+
+
+def _steps(params: RigParameters, keys: tuple[str, ...], spans: Sequence[float] | None
+           ) -> list[float]:
+    """Each key's difference step, one the floats take exactly (a key's own seed is then 1
+    to the bit)."""
+    sizes = [abs(params.number(k)) for k in keys]
+    scales = [max(size, span) for size, span in
+              zip(sizes, spans if spans is not None else [1.0] * len(keys), strict=True)]
+    return [(params.number(k) + _SETUP_STEP * scale) - params.number(k)
+            for k, scale in zip(keys, scales, strict=True)]
+
+
+def _logged_along(run: ClassifiedRun, result: SimulationResult, logged: Run,
+                  tangent: np.ndarray, angle: np.ndarray | None) -> dict[str, np.ndarray]:
+    """The logger's read (``logged`` of ``result``) of the simulation's derivative
+    ``tangent`` (n, N_CHANNELS), the set held: a difference along it, with a step the
+    rounding of the channels it reads does not swallow."""
+    read = list(_READ)
+    size = np.max(np.abs(result.data[:, read]), axis=0)
+    reach = np.max(np.abs(tangent[:, read]), axis=0)
+    moving = reach > 0.0
+    if not np.any(moving):
+        return {c: np.zeros(len(run)) for c in CHANNELS}
+    step = _DATA_STEP * float(np.min(np.maximum(size[moving], 1e-300) / reach[moving]))
+    moved = _as_logged(run, replace(result, data=result.data + step * tangent), angle)
+    return {c: (getattr(moved, c) - getattr(logged, c)) / step for c in CHANNELS}
 
 
 def simulate_all(runs: Sequence[Run], params: RigParameters) -> list[Run]:

@@ -32,7 +32,11 @@ from landing_gear_sim.calibration.statistics import (
     effective_count,
     input_timing_std_s,
 )
-from landing_gear_sim.diagnosis.objective import Scales, scaled_residuals
+from landing_gear_sim.diagnosis.objective import (
+    Scales,
+    scaled_residuals,
+    scaled_residuals_and_jacobian,
+)
 from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
@@ -42,7 +46,7 @@ from msg_tools.units import PA_PER_BAR
 
 START_RATIO = 2.0  # multi-start: optimise only starts this close to the best initial cost
 PROBE_ITERATIONS = 3  # multi-start: each start gets this many steps, then only the best goes on
-MAX_ITERATIONS = 40  # the budget of one optimisation (each step simulates the runs 1 + n times)
+MAX_ITERATIONS = 40  # the budget of one optimisation, in evaluations (each Jacobian adds n more)
 # a fit stops when a step lowers the cost by less than this fraction: costs are ~1e4-1e5
 # (noise-scaled squares), so that is < 0.5 in χ², far below the ΔBIC threshold of 10
 # (scipy's default, 1e-8, went on for twice the steps to gain < 1)
@@ -198,13 +202,15 @@ CATALOGUE: dict[str, Candidate] = {c.cause: c for c in (
 @dataclass(frozen=True)
 class CandidateFit:
     """A fitted candidate (or its null: the same free parameters without it): the
-    parameter set, values and 1-σ of what was fitted, and the scaled residual."""
+    parameter set, values and 1-σ of what was fitted, the scaled residual, and whether the
+    fit stopped on its budget of steps rather than on its tolerance."""
 
     candidate: Candidate
     params: RigParameters
     values: dict[str, float]
     std: dict[str, float]
     residual: np.ndarray
+    stopped: bool = False
 
     @property
     def cost(self) -> float:
@@ -265,7 +271,7 @@ def fit_candidate(candidate: Candidate, runs: Sequence[Run], base: RigParameters
     resumed = bool(problem.own and ended)
     points = _starts(candidate, problem, references, ended if resumed else None)
     start = _best_start(candidate, problem, points, tries, resumed)
-    best = _optimise(Objective(problem.residuals, known=start), start[0], MAX_ITERATIONS)
+    best = _optimise(problem.objective(start), start[0], MAX_ITERATIONS)
     return _fitted(candidate, problem, best, chosen)
 
 
@@ -287,6 +293,23 @@ class _Problem:
         trials = [self.model.replace(dict(zip(self.keys, self.window.value(u), strict=True)),
                                      "fit") for u in points]
         return scaled_residuals(self.chosen, trials, self.channels, self.scales)
+
+    def objective(self, known: Start) -> Objective:
+        """The fit's objective, from ``known`` (a point, its residual, its Jacobian)."""
+        return Objective(self.residuals, known=known, derivatives=self.derivatives)
+
+    def derivatives(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """The scaled residual at ``u`` (unit box) and its Jacobian there, from the
+        plant's own derivatives (None where the plant alone does not give them)."""
+        trial = self.model.replace(dict(zip(self.keys, self.window.value(u), strict=True)),
+                                   "fit")
+        spans = self.window.upper - self.window.lower
+        found = scaled_residuals_and_jacobian(self.chosen, trial, self.keys, spans,
+                                              self.channels, self.scales)
+        if found is None:
+            return None
+        error, jacobian = found
+        return error, jacobian * self.window.slope(u)
 
 
 def _problem(candidate: Candidate, chosen: Sequence[ClassifiedRun], base: RigParameters,
@@ -346,8 +369,8 @@ def _best_start(candidate: Candidate, problem: _Problem, points: list[np.ndarray
         return points[order[0]], at_points[order[0]], None
     # successive halving: the starts' first steps tell the basins apart; running each to
     # the end cost twice the time and always ended on the same optimum
-    probes = [_optimise(Objective(problem.residuals, known=(points[i], at_points[i], None)),
-                        points[i], PROBE_ITERATIONS) for i in order]
+    probes = [_optimise(problem.objective((points[i], at_points[i], None)), points[i],
+                        PROBE_ITERATIONS) for i in order]
     probe = min(probes, key=lambda fit: fit.cost)
     return probe.x, probe.fun, probe.jac
 
@@ -364,7 +387,8 @@ def _fitted(candidate: Candidate, problem: _Problem, best: OptimizeResult,
     fitted = problem.model.replace(dict(zip(keys, values, strict=True)),
                                    f"fit {candidate.cause}")
     return CandidateFit(candidate, fitted, dict(zip(keys, map(float, values), strict=True)),
-                        dict(zip(keys, map(float, std), strict=True)), best.fun)
+                        dict(zip(keys, map(float, std), strict=True)), best.fun,
+                        stopped=best.status == 0)  # scipy's "max_nfev reached"
 
 
 def _optimise(objective: Objective, start: np.ndarray, iterations: int) -> OptimizeResult:

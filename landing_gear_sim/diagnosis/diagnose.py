@@ -14,11 +14,13 @@
 """
 from __future__ import annotations
 
+import threading
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from landing_gear_sim.calibration import differences
 from landing_gear_sim.calibration.actuator import LATE
 from landing_gear_sim.calibration.identify import Identification, Progress, identify
 from landing_gear_sim.calibration.measured import CHANNELS, simulate_all
@@ -62,6 +64,7 @@ from landing_gear_sim.diagnosis.start import FRICTION_CURVE, starting_model
 from landing_gear_sim.errors import DiagnosisError
 from landing_gear_sim.model.datasheet import datasheet_values
 from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.sensitivity import prepare_kernels
 from landing_gear_sim.processes import single_threaded_blas
 from msg_tools.run import Run
 
@@ -135,6 +138,8 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     """The diagnosis as its stages: calibrate the starting model, search the catalogue in
     rounds, extend the model by a discovered term, judge the verdict."""
     say = progress or (lambda _msg: None)
+    if differences.MODEL_DERIVATIVES:
+        _prepare_derivatives(base, say)
     start = _calibrated_start(runs, base, without, say)
     search = rounds.search(start.runs, start.start, start.without, start.calibrated, base,
                            start.scales, start.before, start.pending, start.problems, say)
@@ -159,6 +164,22 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
                      start.calibrated, model, start.before, after, problems, evidence, checks,
                      calibrated_checks, start.calibration.estimates,
                      local_gains(start.runs, start.calibrated), local_gains(start.runs, model))
+
+
+DERIVATIVES_NOTE_AFTER_S = 2.0  # loading them from numba's cache takes a fraction of that
+
+
+def _prepare_derivatives(base: RigParameters, say: Progress) -> None:
+    """The plant's derivatives compiled before the fits' processes fork, saying so when that
+    takes its minute (once after an install) rather than on every run."""
+    note = threading.Timer(DERIVATIVES_NOTE_AFTER_S, lambda: say(
+        "compiling the plant's derivatives for this machine (once after an install, ~1 min)"))
+    note.daemon = True
+    note.start()
+    try:
+        prepare_kernels(base)
+    finally:
+        note.cancel()
 
 
 @dataclass

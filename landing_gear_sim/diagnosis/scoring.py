@@ -29,6 +29,7 @@ from landing_gear_sim.calibration.runs import (
     setup_of,
 )
 from landing_gear_sim.calibration.statistics import effective_count
+from landing_gear_sim.diagnosis import catalogue
 from landing_gear_sim.diagnosis.catalogue import (
     Candidate,
     CandidateFit,
@@ -228,7 +229,7 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
         else ""
     rejected = _rejection(delta_bic, held, at_bound, beyond)
     accepted = not rejected
-    reason = rejected or ACCEPTED
+    reason = _reason(rejected, with_it)
     parameters = key_parameters(candidate, with_it.params)
     std = key_std(candidate, with_it)
     evidence = _evidence(candidate, delta_bic, held, fit_runs, held_runs, signatures) \
@@ -242,6 +243,14 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
                       accepted=accepted, fitted_on=_names(fit_runs),
                       checked_on=_names(held_runs), family=candidate.family, reason=reason)
     return Scored(finding, with_it)
+
+
+def _reason(rejected: str, fit: CandidateFit) -> str:
+    """Why the candidate is rejected (or that it meets every rule), and that its fit
+    stopped on its budget when it did: its values may not be its optimum's."""
+    stopped = (f"; its fit stopped at its budget of {catalogue.MAX_ITERATIONS} evaluations, "
+               "not on its tolerance") if fit.stopped else ""
+    return (rejected or ACCEPTED) + stopped
 
 
 _NULLS: dict[str, CandidateFit] = {}

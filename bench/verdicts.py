@@ -68,7 +68,7 @@ def _shared(kind: str) -> Iterator[Campaign]:
 
 def _bench(root: Path) -> Iterator[Campaign]:
     base = load_parameters()
-    for i, (name, (effect, without, names, _)) in enumerate(bench_diagnose.CASES.items()):
+    for i, (name, (effect, without, names)) in enumerate(bench_diagnose.CASES.items()):
         def make(folder: Path, i: int = i, effect: dict = effect,
                  names: tuple[str, ...] | None = names) -> None:
             rig = rig_like(base, np.random.default_rng(500 + i)).replace(effect, "hidden effect")

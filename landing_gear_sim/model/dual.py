@@ -20,18 +20,17 @@ source, and the dual one's values are the plain one's to the bit.
 
 The lane count is part of the type: each count compiles the kernel once (cached on disk);
 :func:`lanes_for` rounds a count up to the few that are compiled. LLVM's loop vectorizer is
-off while a dual kernel compiles (:func:`dual_compilation`): it turned the per-lane
+off while a dual kernel compiles (:func:`call_dual`): it turned the per-lane
 arithmetic into shuffles that cost up to 4× (a 4-lane stop took 8× a plain one, 2.2× without
 it); the plain kernels lose nothing without it either (measured: within 2 %).
 """
 
 from __future__ import annotations
 
-import contextlib
 import math
 import operator
 import threading
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -129,6 +128,17 @@ def _scaled(typingctx, v, a, ca):
                     for t in tangents_of(builder, da, signature.return_type.lanes)]
         return dual_from(builder, context, signature.return_type, value, tangents)
     return a(types.float64, a, types.float64), codegen
+
+
+@intrinsic
+def _lifted(typingctx, v, like):
+    """The number ``v`` as a dual of ``like``'s lanes, its derivatives 0 (not 0·``like``'s:
+    those may be a NaN)."""
+    def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
+        zero = context.get_constant(types.float64, 0.0)
+        return dual_from(builder, context, signature.return_type, args[0],
+                         [zero] * signature.return_type.lanes)
+    return like(types.float64, like), codegen
 
 
 @lower_cast(types.Float, DualType)
@@ -348,7 +358,7 @@ def as_dual(x: Any, like: Any) -> Any:
 def _as_dual(x, like) -> Callable[..., Any]:
     if not is_dual(like) or is_dual(x):
         return lambda x, like: x
-    return lambda x, like: _scaled(x * 1.0, like, 0.0)
+    return lambda x, like: _lifted(x * 1.0, like)
 
 
 def _extreme(fns: tuple[Callable[..., Any], ...], first: Callable[[Any, Any], bool]) -> None:
@@ -395,26 +405,26 @@ def _mixed_getitem(signals, i) -> Callable[..., Any] | None:
 
 
 _compiling = threading.Lock()
-_compiled: set[int] = set()
 
 
-@contextlib.contextmanager
-def dual_compilation(lanes: int) -> Iterator[None]:
-    """Make a dual kernel's first call with ``lanes`` inside this: it compiles (or loads)
-    with LLVM's loop vectorizer off (see the module's note); later calls run as they come,
-    side by side."""
-    if lanes in _compiled:
-        yield
-        return
-    with _compiling:
-        # read from the environment when numba loads: not in its stubs
-        before = config.LOOP_VECTORIZE  # type: ignore[attr-defined]
-        config.LOOP_VECTORIZE = 0  # type: ignore[attr-defined]
-        try:
-            yield
-        finally:
-            config.LOOP_VECTORIZE = before  # type: ignore[attr-defined]
-        _compiled.add(lanes)
+def call_dual(kernel: Any, *args: Any) -> Any:
+    """Call a compiled ``kernel`` with dual arguments. A first call with these argument
+    types compiles (or loads) it with LLVM's loop vectorizer off (see the module's note);
+    the setting is numba's, for the whole process, so only while that compilation runs. A
+    later call with other types (a run that follows a measured wheel angle) compiles its
+    own, off too: compiled with it on, the same derivatives came out different in their last
+    bits, and slower."""
+    signature = tuple(kernel.typeof_pyval(arg) for arg in args)
+    if signature not in kernel.overloads:
+        with _compiling:
+            # read from the environment when numba loads: not in its stubs
+            before = config.LOOP_VECTORIZE  # type: ignore[attr-defined]
+            config.LOOP_VECTORIZE = 0  # type: ignore[attr-defined]
+            try:
+                kernel.compile(signature)
+            finally:
+                config.LOOP_VECTORIZE = before  # type: ignore[attr-defined]
+    return kernel(*args)
 
 
 def lanes_for(count: int) -> int:

@@ -23,7 +23,7 @@ import numpy as np
 from landing_gear_sim.errors import ParameterError
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.actuator import ACT_DELAY_STEPS, actuator_matrices
-from landing_gear_sim.model.dual import LANES, dual_compilation, lanes_for
+from landing_gear_sim.model.dual import LANES, call_dual, lanes_for
 from landing_gear_sim.model.dual_arrays import DualRows, DualVector
 from landing_gear_sim.model.integrate import STOP_REASONS, SimulationResult, run_kernel
 from landing_gear_sim.model.parameters import INDEX, RigParameters
@@ -105,11 +105,10 @@ def _dual_pass(vector: np.ndarray, matrices: np.ndarray, scenario: Scenario,
     n = scenario.current_a.size
     out = DualRows(np.empty((n, N_CHANNELS)), np.empty((n, N_CHANNELS, lanes)))
     angle = np.zeros(0) if scenario.wheel_angle_rad is None else scenario.wheel_angle_rad
-    with dual_compilation(lanes):
-        rows, stop = run_kernel(DualVector(vector, seeds), DualVector(matrices, matrix_seeds),
-                                scenario.current_a, scenario.step_s, scenario.contact,
-                                scenario.initial_speed_m_s, scenario.stop_speed_m_s, angle,
-                                out, scenario.settled_start)
+    rows, stop = call_dual(run_kernel, DualVector(vector, seeds),
+                           DualVector(matrices, matrix_seeds), scenario.current_a,
+                           scenario.step_s, scenario.contact, scenario.initial_speed_m_s,
+                           scenario.stop_speed_m_s, angle, out, scenario.settled_start)
     return int(rows), int(stop), out.values, out.tangents
 
 

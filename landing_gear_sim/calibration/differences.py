@@ -112,6 +112,16 @@ class Objective:
         return True
 
 
+def stacked(parts: Sequence[tuple[np.ndarray, np.ndarray] | None]
+            ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The runs' (residual, Jacobian) parts stacked in their order; None if a run has none
+    (its model gives no derivatives there)."""
+    if any(part is None for part in parts):
+        return None
+    return (np.concatenate([part[0] for part in parts if part is not None]),
+            np.concatenate([part[1] for part in parts if part is not None]))
+
+
 def forward_steps(u: np.ndarray, lower: float = 0.0, upper: float = 1.0) -> np.ndarray:
     """The steps of scipy's '2-point' differences with ``diff_step=DIFF_STEP`` at ``u``
     (>= 0) in the box [lower, upper]: relative, a tiny absolute one where that vanishes,

@@ -5,12 +5,18 @@ leave-one-run-out jackknife for an honest σ."""
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import OptimizeResult, least_squares
 
 from landing_gear_sim.calibration.braking import LOADED_N, Braking, hub_speed
-from landing_gear_sim.calibration.differences import Derivatives, Objective, side_by_side
+from landing_gear_sim.calibration.differences import (
+    Derivatives,
+    Objective,
+    side_by_side,
+    stacked,
+)
 from landing_gear_sim.calibration.measured import simulate_run, simulate_run_with_sensitivities
 from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
 from landing_gear_sim.calibration.slots import Slot
@@ -143,51 +149,9 @@ def refine_friction(runs: Sequence[ClassifiedRun], p: RigParameters, jackknife: 
     Open-loop braking rarely leaves the low-slip region, so the direct fit trades ϑ3
     against ϑ1, ϑ2; the wheel-speed response to the slip excursions pins them down.
     """
-    keys = KEYS
-    start = np.array([p.number(k) for k in keys])
-    windows = [braking_window(r, p) for r in runs]
-    weights = run_weights([int(w.sum()) for w in windows])
-
-    def slip_error(run: ClassifiedRun, simulated: Run, window: np.ndarray, ratio: float
-                   ) -> np.ndarray:
-        # wheel-speed error less what the flywheel-speed error explains: a common speed
-        # offset (noisy initial speed, drag) is not the friction curve's doing
-        wheel = simulated.wheel_speed_rad_s[window] - run.wheel_speed_rad_s[window]
-        flywheel = simulated.flywheel_speed_rad_s[window] - run.flywheel_speed_rad_s[window]
-        return (wheel - ratio * flywheel)[::5]
-
-    def error(trial: RigParameters, i: int) -> np.ndarray:
-        ratio = trial.number(K.FLYWHEEL_RADIUS_M) / trial.number(K.WHEEL_UNLOADED_RADIUS_M)
-        simulated, _ = simulate_run(runs[i], trial)
-        return weights[i] * slip_error(runs[i], simulated, windows[i], ratio)
-
-    def trial(theta: np.ndarray) -> RigParameters:
-        return p.replace(dict(zip(keys, theta * start, strict=True)), "identify")
-
-    def residuals(thetas: Sequence[np.ndarray], chosen: Sequence[int]) -> list[np.ndarray]:
-        # every (θ, run) simulated side by side: a Jacobian's columns share the cores
-        return side_by_side(error, [trial(theta) for theta in thetas], chosen)
-
-    def derivatives(theta: np.ndarray, chosen: Sequence[int]
-                    ) -> tuple[np.ndarray, np.ndarray] | None:
-        params = trial(theta)
-        ratio = params.number(K.FLYWHEEL_RADIUS_M) / params.number(K.WHEEL_UNLOADED_RADIUS_M)
-
-        def one(i: int) -> tuple[np.ndarray, np.ndarray] | None:
-            found = simulate_run_with_sensitivities(runs[i], params, keys, list(start))
-            if found is None:
-                return None
-            simulated, d = found
-            slope = (d["wheel_speed_rad_s"] - ratio * d["flywheel_speed_rad_s"])[windows[i]]
-            return (weights[i] * slip_error(runs[i], simulated, windows[i], ratio),
-                    weights[i] * slope[::5] * start)
-
-        parts = map_threads(one, chosen)
-        if any(part is None for part in parts):
-            return None
-        return (np.concatenate([part[0] for part in parts if part is not None]),
-                np.concatenate([part[1] for part in parts if part is not None]))
-
+    problem = _Refinement.of(runs, p)
+    start = problem.start
+    residuals, derivatives = problem.residuals, problem.derivatives
     every = range(len(runs))
     fit = _least_squares(lambda thetas: residuals(thetas, every),
                          lambda theta: derivatives(theta, every), np.ones(3),
@@ -207,7 +171,65 @@ def refine_friction(runs: Sequence[ClassifiedRun], p: RigParameters, jackknife: 
     method = "output error on wheel vs flywheel speed; σ: max(residual, jackknife)" + (
         f" (stopped at its budget of {REFINE_ITERATIONS} steps)" if fit.status == 0 else "")
     return [Estimate(k, float(v), float(sd), names, method)
-            for k, v, sd in zip(keys, fit.x * start, std * start, strict=True)]
+            for k, v, sd in zip(KEYS, fit.x * start, std * start, strict=True)]
+
+
+@dataclass(frozen=True)
+class _Refinement:
+    """The output-error refinement's problem: ϑ1..ϑ3 as factors of the direct fit's
+    ``start``, the braking runs' windows and weights, and the flywheel-to-wheel radius
+    ``ratio`` (not among the fitted keys: every trial's)."""
+
+    runs: Sequence[ClassifiedRun]
+    model: RigParameters
+    start: np.ndarray
+    windows: list[np.ndarray]
+    weights: np.ndarray
+    ratio: float
+
+    @classmethod
+    def of(cls, runs: Sequence[ClassifiedRun], p: RigParameters) -> _Refinement:
+        windows = [braking_window(r, p) for r in runs]
+        return cls(runs, p, np.array([p.number(k) for k in KEYS]), windows,
+                   run_weights([int(w.sum()) for w in windows]),
+                   p.number(K.FLYWHEEL_RADIUS_M) / p.number(K.WHEEL_UNLOADED_RADIUS_M))
+
+    def trial(self, theta: np.ndarray) -> RigParameters:
+        return self.model.replace(dict(zip(KEYS, theta * self.start, strict=True)),
+                                  "identify")
+
+    def slip_error(self, i: int, simulated: Run) -> np.ndarray:
+        """Run i's weighted wheel-speed error less what the flywheel-speed error explains: a
+        common speed offset (noisy initial speed, drag) is not the friction curve's doing."""
+        run, window = self.runs[i], self.windows[i]
+        wheel = simulated.wheel_speed_rad_s[window] - run.wheel_speed_rad_s[window]
+        flywheel = simulated.flywheel_speed_rad_s[window] - run.flywheel_speed_rad_s[window]
+        return self.weights[i] * (wheel - self.ratio * flywheel)[::5]
+
+    def residuals(self, thetas: Sequence[np.ndarray], chosen: Sequence[int]
+                  ) -> list[np.ndarray]:
+        """Each ϑ's error over the ``chosen`` runs, every (ϑ, run) simulated side by side
+        (a Jacobian's columns share the cores)."""
+        return side_by_side(lambda trial, i: self.slip_error(i, simulate_run(
+            self.runs[i], trial)[0]), [self.trial(theta) for theta in thetas], chosen)
+
+    def derivatives(self, theta: np.ndarray, chosen: Sequence[int]
+                    ) -> tuple[np.ndarray, np.ndarray] | None:
+        """The error at ϑ over the ``chosen`` runs and its Jacobian, from the plant's own
+        derivatives (None where it gives none)."""
+        params = self.trial(theta)
+
+        def one(i: int) -> tuple[np.ndarray, np.ndarray] | None:
+            found = simulate_run_with_sensitivities(self.runs[i], params, KEYS,
+                                                    list(self.start))
+            if found is None:
+                return None
+            simulated, d = found
+            slope = (d["wheel_speed_rad_s"]
+                     - self.ratio * d["flywheel_speed_rad_s"])[self.windows[i]]
+            return self.slip_error(i, simulated), self.weights[i] * slope[::5] * self.start
+
+        return stacked(map_threads(one, chosen))
 
 
 def _least_squares(residuals: Callable[[Sequence[np.ndarray]], list[np.ndarray]],

@@ -8,7 +8,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from landing_gear_sim.calibration.differences import side_by_side
+from landing_gear_sim.calibration.differences import side_by_side, stacked
 from landing_gear_sim.calibration.measured import (
     simulate_run,
     simulate_run_with_sensitivities,
@@ -59,8 +59,4 @@ def scaled_residuals_and_jacobian(runs: Sequence[Run], params: RigParameters,
                                    for c, s in zip(channels, scale, strict=True)])
         return error, jacobian
 
-    parts = map_threads(one, runs)
-    if any(part is None for part in parts):
-        return None
-    return (np.concatenate([part[0] for part in parts if part is not None]),
-            np.concatenate([part[1] for part in parts if part is not None]))
+    return stacked(map_threads(one, runs))

@@ -98,14 +98,6 @@ def value_of(typingctx, a):
 
 
 @intrinsic
-def tangent_of(typingctx, a, lane):
-    """A dual's derivative along ``lane`` (a compile-time constant)."""
-    def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
-        return builder.extract_value(args[0], lane.literal_value + 1)
-    return types.float64(a, lane), codegen
-
-
-@intrinsic
 def _combined(typingctx, v, a, ca, b, cb):
     """The dual of value ``v`` and derivatives ca·a' + cb·b' (the chain rule of a binary
     operation)."""

@@ -66,9 +66,10 @@ class DualVectorType(types.Type):
 
 @register_model(DualVectorType)
 class _DualVectorModel(models.StructModel):
+    MEMBERS = (("values", types.float64[::1]), ("tangents", types.float64[:, ::1]))
+
     def __init__(self, dmm: Any, fe_type: DualVectorType) -> None:
-        super().__init__(dmm, fe_type, [("values", types.float64[::1]),
-                                        ("tangents", types.float64[:, ::1])])
+        super().__init__(dmm, fe_type, list(self.MEMBERS))
 
 
 make_attribute_wrapper(DualVectorType, "values", "values")
@@ -82,13 +83,18 @@ def _typeof(val: DualVector, c: Any) -> DualVectorType:
 
 @unbox(DualVectorType)
 def _unbox(typ: DualVectorType, obj: Any, c: Any) -> NativeValue:
-    vector = cgutils.create_struct_proxy(typ)(c.context, c.builder)
-    for name, arraytype in (("values", types.float64[::1]),
-                            ("tangents", types.float64[:, ::1])):
+    return _unbox_arrays(typ, obj, c, _DualVectorModel.MEMBERS)
+
+
+def _unbox_arrays(typ: types.Type, obj: Any, c: Any,
+                  members: tuple[tuple[str, types.Array], ...]) -> NativeValue:
+    """A Python object's array attributes ``members`` as the struct of ``typ``."""
+    struct = cgutils.create_struct_proxy(typ)(c.context, c.builder)
+    for name, arraytype in members:
         member = c.pyapi.object_getattr_string(obj, name)
-        setattr(vector, name, c.unbox(arraytype, member).value)
+        setattr(struct, name, c.unbox(arraytype, member).value)
         c.pyapi.decref(member)
-    return NativeValue(vector._getvalue())
+    return NativeValue(struct._getvalue())
 
 
 @intrinsic
@@ -230,9 +236,10 @@ class DualRowsType(types.Type):
 
 @register_model(DualRowsType)
 class _DualRowsModel(models.StructModel):
+    MEMBERS = (("values", types.float64[:, ::1]), ("tangents", types.float64[:, :, ::1]))
+
     def __init__(self, dmm: Any, fe_type: DualRowsType) -> None:
-        super().__init__(dmm, fe_type, [("values", types.float64[:, ::1]),
-                                        ("tangents", types.float64[:, :, ::1])])
+        super().__init__(dmm, fe_type, list(self.MEMBERS))
 
 
 make_attribute_wrapper(DualRowsType, "values", "values")
@@ -246,13 +253,7 @@ def _typeof_rows(val: DualRows, c: Any) -> DualRowsType:
 
 @unbox(DualRowsType)
 def _unbox_rows(typ: DualRowsType, obj: Any, c: Any) -> NativeValue:
-    rows = cgutils.create_struct_proxy(typ)(c.context, c.builder)
-    for name, arraytype in (("values", types.float64[:, ::1]),
-                            ("tangents", types.float64[:, :, ::1])):
-        member = c.pyapi.object_getattr_string(obj, name)
-        setattr(rows, name, c.unbox(arraytype, member).value)
-        c.pyapi.decref(member)
-    return NativeValue(rows._getvalue())
+    return _unbox_arrays(typ, obj, c, _DualRowsModel.MEMBERS)
 
 
 @overload(operator.getitem)

@@ -71,7 +71,7 @@ def simulate_with_sensitivities(params: RigParameters, scenario: Scenario,
         for lane, key in enumerate(keys):
             seeds[INDEX[key], lane] = 1.0
     matrices = actuator_matrices(vector, scenario.step_s)
-    moved = _matrix_derivatives(vector, scenario.step_s, seeds)
+    moved = _matrix_derivatives(vector, matrices.size, scenario.step_s, seeds)
     lanes = lanes_for(len(keys))
     starts = range(0, max(len(keys), 1), lanes)
     passes = [_dual_pass(vector, matrices, scenario, seeds[:, start:start + lanes],
@@ -112,10 +112,11 @@ def _dual_pass(vector: np.ndarray, matrices: np.ndarray, scenario: Scenario,
     return int(rows), int(stop), out.values, out.tangents
 
 
-def _matrix_derivatives(vector: np.ndarray, step_s: float, seeds: np.ndarray
+def _matrix_derivatives(vector: np.ndarray, size: int, step_s: float, seeds: np.ndarray
                         ) -> np.ndarray:
-    """How A(s)'s discrete matrices move along each column of ``seeds``, (M, columns)."""
-    moved = np.zeros((actuator_matrices(vector, step_s).size, seeds.shape[1]))
+    """How A(s)'s discrete matrices (``size`` entries) move along each column of ``seeds``,
+    (size, columns)."""
+    moved = np.zeros((size, seeds.shape[1]))
     for key in MATRIX_KEYS:
         along = seeds[INDEX[key]]
         if np.any(along != 0.0):

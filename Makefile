@@ -42,10 +42,10 @@ lint: $(STAMP)
 	$(BIN)/mypy
 
 test: lint
-	$(BIN)/python -m pytest -q -n 2 test
+	$(BIN)/python -m pytest -q -n 2 --dist loadgroup test
 
 test-slow: lint
-	$(BIN)/python -m pytest -q -n 2 --slow test
+	$(BIN)/python -m pytest -q -n 2 --dist loadgroup --slow test
 
 bench: $(STAMP)
 	$(BIN)/python bench/run.py

@@ -54,7 +54,7 @@ DISPLAY: dict[str, tuple[str, float]] = {
     "N": ("kN", 1e-3), "1/run": ("%/run", 100.0), "Pa/A": ("bar/A", 1.0 / PA_PER_BAR),
     "Pa/A^2": ("bar/A²", 1.0 / PA_PER_BAR), "Pa/A^3": ("bar/A³", 1.0 / PA_PER_BAR),
     "1/Pa": ("1/bar", PA_PER_BAR), "s/Pa": ("ms/bar", 1e3 * PA_PER_BAR),
-    "1/Pa^2": ("1/bar²", PA_PER_BAR ** 2),
+    "1/Pa^2": ("1/bar²", PA_PER_BAR ** 2), "J": ("MJ", 1e-6),
 }
 """SI unit -> the unit a brake engineer reads a term's value in, and the factor to it."""
 

@@ -25,6 +25,7 @@ import numpy as np
 import pytest
 
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
+from landing_gear_sim.calibration.measured import CHANNELS, channel_words
 from landing_gear_sim.cli import main
 from landing_gear_sim.diagnosis.catalogue import CATALOGUE, gear_walk_key_parameters
 from landing_gear_sim.diagnosis.consistency import inconsistent
@@ -315,12 +316,20 @@ def _rows(tables: _Tables, heading: str) -> list[dict[str, str]]:
 
 
 def _number(text: str) -> float | None:
-    return None if text == "-" else float(text)
+    """A cell's number: '+1260.5', or an evidence class's 'decisive (-78.5)'."""
+    if text == "-":
+        return None
+    classed = re.fullmatch(r"(decisive|strong|positive|weak|against) \((\S+)\)", text)
+    return float(classed[2] if classed else text)
+
+
+_CODE_NAMES = {channel_words(c): c for c in CHANNELS}
 
 
 def _fits(text: str) -> dict[str, float]:
-    pairs = (item.split(": ") for item in text.split(", ") if item)
-    return {channel: float(value.removesuffix(" %")) for channel, value in pairs}
+    """'brake pressure 97.75 %, wheel speed 99.70 %' as the JSON's code names and values."""
+    pairs = (item.removesuffix(" %").rsplit(" ", 1) for item in text.split(", ") if item)
+    return {_CODE_NAMES[words]: float(value) for words, value in pairs}
 
 
 _CELL = re.compile(r"(?P<deviation>\S+) ± (?P<std>\S+) (?P<unit>.+?) \((?P<phase>.*)\)"
@@ -333,7 +342,7 @@ def test_every_number_in_the_pages_tables_is_the_one_in_the_json(delay_diagnosed
     of each table is the JSON's, and a calibrated cell is the check measuring the same."""
     document, tables = delay_diagnosed.document, _Tables(delay_diagnosed.page)
 
-    baseline = {row["channel"]: float(row["fit %"])
+    baseline = {_CODE_NAMES[row["channel"]]: float(row["fit %"])
                 for row in _rows(tables, "Starting model, calibrated: fit %")}
     assert baseline == pytest.approx(document["baseline"], abs=0.006)
 
@@ -341,8 +350,9 @@ def test_every_number_in_the_pages_tables_is_the_one_in_the_json(delay_diagnosed
     assert len(findings) == len(document["findings"]) > 0
     for row, finding in zip(findings, document["findings"], strict=True):
         assert row["cause"].split(" ")[0] == finding["cause"]
-        assert _number(row["ΔBIC"]) == pytest.approx(finding["delta_bic"], abs=0.051)
-        assert _number(row["held-out improvement"]) == pytest.approx(
+        assert _number(row["evidence (ΔBIC)"]) == pytest.approx(finding["delta_bic"],
+                                                                abs=0.051)
+        assert _number(row["held-out log-likelihood gain"]) == pytest.approx(
             -finding["held_out_delta"], abs=0.051)
         assert _fits(row["held-out fit before"]) == pytest.approx(finding["fit_before"],
                                                                   abs=0.006)
@@ -360,7 +370,8 @@ def test_every_number_in_the_pages_tables_is_the_one_in_the_json(delay_diagnosed
             said = parameter_text(key, value, None, candidate.get("units", {}).get(key))
             name_value = re.match(r"\S+ = \S+", said)
             assert name_value and name_value[0] in row["key parameters"], (key, row)
-        for column, key in (("ΔBIC", "delta_bic"), ("held-out improvement", "held_out_delta")):
+        for column, key in (("evidence (ΔBIC)", "delta_bic"),
+                            ("held-out log-likelihood gain", "held_out_delta")):
             expected = candidate[key]
             sign = -1 if key == "held_out_delta" else 1
             assert _number(row[column]) == (None if expected is None else pytest.approx(
@@ -397,6 +408,9 @@ def test_every_number_in_the_pages_tables_is_the_one_in_the_json(delay_diagnosed
     ("load_sensitivity_per_n", 1.022e-5, 2.9e-8, "load_sensitivity = 1.022 ± 0.0029 %/kN"),
     # a discovered term's name, whole (U04's page had read '5 bar] = 148.3 ± 0.24')
     ("[P > 0.5 bar]", 148.3, 0.24, "[P > 0.5 bar] = 148.3 ± 0.24"),
+    # issue 63: were 'fade_energy = 9.646e+07 ± 1.5e+02 J' and 'gain_n_m = 153.3 1/bar'
+    ("brake_fade.fade_energy_j", 9.646e7, 150.0, "fade_energy = 96.46 ± 0.00015 MJ"),
+    ("brake_fade.gain_n_m_per_pa", 1.533e-3, 1.6e-7, "gain = 153.3 ± 0.016 N m/bar"),
 ])
 def test_a_parameter_reads_in_engineering_units(key, value, std, text):
     assert parameter_text(key, value, std) == text
@@ -645,7 +659,8 @@ def test_a_verdict_of_none_shows_no_empty_findings_table(reference, tmp_path):
                        start=reference, calibrated=reference, extended=reference,
                        signatures_before=[], signatures_after=[])
     page = write_diagnosis_report(result, tmp_path).read_text()
-    verdict = page[page.index("<h2>Verdict"):page.index("<h2>", page.index("<h2>Verdict") + 1)]
+    start = page.index(">Verdict</h2>")
+    verdict = page[start:page.index("<h2", start)]
     assert "nothing is missing" in verdict and "<table" not in verdict
 
 

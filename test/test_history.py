@@ -3,7 +3,9 @@ and a real scheduler whose worker dies mid-run."""
 
 from __future__ import annotations
 
+import contextlib
 import csv
+import io
 import json
 import os
 import signal
@@ -18,6 +20,9 @@ import pytest
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.campaigns.history import campaign_folders, parameter_change
 from landing_gear_sim.cli import main
+
+# the five identified days are one fixture: on one worker, its tests compute them once
+pytestmark = pytest.mark.xdist_group("history")
 
 GAIN = "brake.gain_n_m_per_pa"
 DROP = 0.88  # the pads replaced before the 4th test day: 12 % less torque per bar
@@ -76,12 +81,24 @@ def test_a_folder_of_campaigns_is_split_into_its_days(history):
     assert campaign_folders([history / "2026-03-02"]) == [history / "2026-03-02"]
 
 
-def test_history_finds_the_new_pads_and_resumes_without_redoing(history, tmp_path, capsys):
-    out = tmp_path / "out"
-    code = main(["history", str(history), "--no-diagnose", "--workers", "2", "-o", str(out)])
-    printed = capsys.readouterr()
-    assert code == 0, printed.err
-    assert f"{GAIN}: step" in printed.out and "from 2026-03-04 on" in printed.out
+@pytest.fixture(scope="module")
+def identified_history(history, tmp_path_factory) -> tuple[Path, str, str]:
+    """The five days identified by a local pool of two (``history --no-diagnose``): the
+    output folder, and what the command printed and said on stderr. The cluster's run
+    is compared with this table."""
+    out = tmp_path_factory.mktemp("identified") / "out"
+    printed, said = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(printed), contextlib.redirect_stderr(said):
+        code = main(["history", str(history), "--no-diagnose", "--workers", "2", "-o",
+                     str(out)])
+    assert code == 0, said.getvalue()
+    return out, printed.getvalue(), said.getvalue()
+
+
+def test_history_finds_the_new_pads_and_resumes_without_redoing(history, identified_history,
+                                                                capsys):
+    out, printed, _ = identified_history
+    assert f"{GAIN}: step" in printed and "from 2026-03-04 on" in printed
     changes = json.loads((out / "changes.json").read_text())["changes"]
     step = next(c for c in changes if c["key"] == GAIN)
     assert step["size"] == pytest.approx(DROP - 1, abs=0.02)
@@ -121,13 +138,11 @@ def _wait_for(condition, timeout_s: float, what: str) -> None:
         time.sleep(0.1)
 
 
-def test_a_worker_killed_mid_run_loses_nothing(history, tmp_path, capsys):
+def test_a_worker_killed_mid_run_loses_nothing(history, identified_history, tmp_path):
     """A real `dask scheduler` and two `dask worker` processes on 127.0.0.1; one worker is
     killed once the first campaign is in: the table is complete and identical to that of
     a local run."""
-    local = tmp_path / "local"
-    assert main(["history", str(history), "--no-diagnose", "--workers", "1", "-o",
-                 str(local)]) == 0
+    local, _, _ = identified_history
     address_file = tmp_path / "scheduler.json"
     processes = [_dask("dask_scheduler", "--host", "127.0.0.1", "--port", "0",
                        "--no-dashboard", "--scheduler-file", str(address_file))]

@@ -3,6 +3,7 @@ reason for every candidate's yes or no."""
 
 from __future__ import annotations
 
+import dataclasses
 import html
 import re
 
@@ -109,8 +110,51 @@ def test_the_first_screen_draws_where_the_starting_model_misses_the_verdicts_cha
     assert shown[0] < 4.0 < shown[-1] and shown[-1] - shown[0] < 0.5 * (run.time_s[-1]
                                                                          - run.time_s[0])
     page = write_diagnosis_report(result, tmp_path).read_text()
-    verdict = page[page.index("<h2>Verdict"):page.index("Starting model")]
+    start = page.index(">Verdict</h2>")
+    verdict = page[start:page.index("<h2", start)]
     assert "where_it_misses.png" in verdict and (tmp_path / "where_it_misses.png").exists()
+
+
+def test_the_first_screen_draws_a_held_out_run_with_the_measured_trace_on_top(
+        reference, tmp_path, monkeypatch):
+    """Issue 63: the figure showed actuator_steps_sweep, a run the delay was fitted on, while
+    the headline is held out, and the black measured trace lay under the red extended
+    model. The run drawn is now one the finding was checked on, the measured trace drawn
+    last, and the residuals before and after below."""
+    import dataclasses
+
+    from landing_gear_sim.calibration.runs import classified
+    from landing_gear_sim.diagnosis.diagnose import Diagnosis
+    from landing_gear_sim.diagnosis.findings import Finding
+    from landing_gear_sim.diagnosis.signatures import RunEvidence
+    from landing_gear_sim.model import scenario as sc
+    from landing_gear_sim.model.integrate import simulate
+    from landing_gear_sim.report import first_screen
+
+    def evidence(bar: float, size: float) -> RunEvidence:
+        run = simulate(reference, sc.constant_pressure_test(reference, bar * 1e5)).to_run(1)
+        missed = dataclasses.replace(run, name=f"stop_{bar:g}bar",
+                                     wheel_speed_rad_s=run.wheel_speed_rad_s + size)
+        return RunEvidence(classified(missed), run, missed, "wheel_speed_rad_s", None)
+
+    found = Finding(cause="discovered", parameters={}, std={}, evidence="",
+                    fit_before={"wheel_speed_rad_s": 90.0}, fit_after={"wheel_speed_rad_s": 95.0},
+                    delta_bic=-50.0, held_out=-80.0, accepted=True, family="wheel",
+                    fitted_on=("stop_30bar",), checked_on=("stop_20bar (2.0-9.0 s)",))
+    result = Diagnosis(verdict="discovered", findings=[found], candidates=[], baseline={},
+                       start=reference, calibrated=reference, extended=reference,
+                       signatures_before=[], signatures_after=[],
+                       evidence=[evidence(20, 1.0), evidence(30, 6.0)])
+    misfit = first_screen.worst_misfit(result)
+    assert misfit.evidence.run.name == "stop_20bar" and misfit.held_out
+    saved = _figures_saved(monkeypatch, first_screen)
+    first_screen.plot_misfit(misfit, tmp_path / "f.png")
+    top, bottom = saved[0].axes[:2]
+    measured = next(line for line in top.lines if line.get_label() == "measured")
+    assert measured.get_zorder() > max(line.get_zorder() for line in top.lines
+                                       if line is not measured)
+    assert "stop_20bar, held out:" in saved[0].get_suptitle()
+    assert len(bottom.lines) >= 2  # before and after
 
 
 def _figures_saved(monkeypatch, *modules):
@@ -266,3 +310,32 @@ def test_one_number_reads_one_value_on_the_page_and_in_the_terminal(reference, t
     assert "0.005994" not in page
     for number in ("-78.5", "+1260.5"):
         assert number in terminal and number in page, (number, terminal)
+
+
+def test_the_page_speaks_in_the_engineers_words_and_units(reference, tmp_path):
+    """Issue 63, item 2: the title read 'Diagnosis: actuator_delay', the tables
+    'pressure_pa: 97.75 %', scores were log-likelihood units alone, and the baseline's 97.04 %
+    stood beside a held-out 'before' of 97.75 % unexplained."""
+    from landing_gear_sim.diagnosis.diagnose import Diagnosis
+    from landing_gear_sim.diagnosis.findings import Finding
+    from landing_gear_sim.report.diagnosis import write_diagnosis_report
+
+    found = Finding(cause="actuator_delay", parameters={"delay_s": 0.006003},
+                    std={"delay_s": 0.00029}, evidence="", fit_before={"pressure_pa": 97.75},
+                    fit_after={"pressure_pa": 98.5}, rmse_before={"pressure_pa": 0.3e5},
+                    rmse_after={"pressure_pa": 0.15e5}, delta_bic=-78.5, held_out=-1260.5,
+                    accepted=True, checked_on=("brake_osc_low",))
+    weak = dataclasses.replace(found, cause="pressure_sensor_offset", parameters={},
+                               delta_bic=-1.2, accepted=False, round=1)
+    result = Diagnosis(verdict="actuator_delay", findings=[found], candidates=[found, weak],
+                       baseline={"pressure_pa": 97.04, "wheel_speed_rad_s": 99.1},
+                       start=reference, calibrated=reference, extended=reference,
+                       signatures_before=[], signatures_after=[])
+    page = html.unescape(write_diagnosis_report(result, tmp_path).read_text())
+    assert "<title>Diagnosis: The valve answers later than the model's</title>" in page
+    tables = " ".join(re.findall(r"<table>.*?</table>", page, re.S))
+    assert "pressure_pa" not in tables and "wheel_speed_rad_s" not in tables
+    assert "brake pressure 97.75 %" in tables and "<td>wheel speed</td>" in tables
+    assert "decisive (-78.5)" in tables and "weak (-1.2)" in tables
+    assert "brake pressure fits 97.8 → 98.5 % (RMSE 0.3 → 0.15 bar)" in tables
+    assert "on <i>every</i> run of the campaign" in page  # what the baseline fit measures

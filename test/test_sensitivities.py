@@ -25,6 +25,9 @@ from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.sensitivity import simulate_with_sensitivities
 
+# the dual kernels compile once per lane count and process: on one worker, once in all
+pytestmark = pytest.mark.xdist_group("dual_kernels")
+
 TOLERANCE = 1e-4  # relative, of the channel's largest derivative over the run
 STEP = 1e-5  # relative step of the central differences
 

@@ -41,6 +41,12 @@ CHANNELS: dict[str, str] = {
     "longitudinal_force_n": "longitudinal force [N]",
 }
 """Measured channels a simulation is compared on (Run fields), with their label."""
+
+
+def channel_words(channel: str) -> str:
+    """A channel as pages, figures and reasons name it ('wheel speed'; its code name, the
+    Run field, stays in the JSON)."""
+    return CHANNELS.get(channel, channel).split(" [")[0]
 ACTUATOR_CHANNELS = ("pressure_pa",)
 """An actuator-only run carries information on the pressure alone."""
 LOWEST_SIM_SPEED_M_S = 1.0  # below this slip is ill-defined; the rig stops at 3 m/s

@@ -174,11 +174,13 @@ def _write_params(result: Identification, path: Path) -> None:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
-    from landing_gear_sim.calibration.validate import validate_campaign
+    from landing_gear_sim.calibration.validate import channel_verdicts, validate_campaign
     from landing_gear_sim.report.pages import text_table
     from landing_gear_sim.report.validation import (
         scores_header,
         scores_table,
+        validation_sentence,
+        verdict_table,
         write_validation_report,
     )
     from msg_tools.io import read_campaign
@@ -191,6 +193,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
     progress(f"simulating {len(campaign.runs)} runs with their measured inputs")
     validation = validate_campaign(campaign.runs, params)
     print(text_table(scores_header(), scores_table(validation.comparisons)))
+    verdicts = channel_verdicts(validation.comparisons)
+    print(f"\n{text_table(*verdict_table(verdicts))}\n{validation_sentence(verdicts)}")
     page = write_validation_report(validation, args.report, f"Validation of {args.campaign}")
     print(f"report: {page}")
     return 0

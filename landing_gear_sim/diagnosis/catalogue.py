@@ -19,6 +19,7 @@ from scipy.optimize import OptimizeResult, least_squares
 
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.differences import Objective
+from landing_gear_sim.calibration.noise import noise_std
 from landing_gear_sim.calibration.runs import (
     ClassifiedRun,
     RunKind,
@@ -216,11 +217,6 @@ class CandidateFit:
     def cost(self) -> float:
         """Sum of squared noise-scaled residuals."""
         return float(self.residual @ self.residual)
-
-
-def noise_std(values: np.ndarray) -> float:
-    """Sensor-noise std of a 1 kHz channel: first differences are noise-dominated."""
-    return float(np.std(np.diff(values)) / math.sqrt(2)) or 1.0
 
 
 def noise_scales(runs: Sequence[Run], channels: Sequence[str]) -> Scales:

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from landing_gear_sim.calibration.braking import lowpass
-from landing_gear_sim.calibration.measured import simulate_all
+from landing_gear_sim.calibration.measured import channel_words, simulate_all
 from landing_gear_sim.calibration.runs import (
     ClassifiedRun,
     RunKind,
@@ -351,9 +351,10 @@ def _worsened(held: HeldOut) -> str:
     channel = min(changes, key=changes.__getitem__, default=None)
     if channel is None or -changes[channel] <= max(held.gain, MAX_LOSS_POINTS):
         return ""
-    return (f"it makes the held-out runs' {channel} worse by {-changes[channel]:.2f} fit-% "
-            f"points ({held.before[channel]:.1f} → {held.after[channel]:.1f} %), more than "
-            f"it makes any channel better (+{held.gain:.2f})")
+    return (f"it makes the held-out runs' {channel_words(channel)} worse by "
+            f"{-changes[channel]:.2f} fit-% points ({held.before[channel]:.1f} → "
+            f"{held.after[channel]:.1f} %), more than it makes any channel better "
+            f"(+{held.gain:.2f})")
 
 
 @dataclass(frozen=True)
@@ -436,12 +437,13 @@ def key_std(candidate: Candidate, fit: CandidateFit) -> dict[str, float]:
 def _evidence(candidate: Candidate, delta_bic: float, held: HeldOut,
               fit_runs: Sequence[Run], held_runs: Sequence[Run],
               signatures: Sequence[Signature]) -> str:
-    words = [f"fitted on {len(fit_runs)} runs ({', '.join(candidate.channels)}): "
+    channels = ", ".join(channel_words(c) for c in candidate.channels)
+    words = [f"fitted on {len(fit_runs)} runs ({channels}): "
              f"ΔBIC {delta_bic:+.0f} against the same base parameters re-fitted without it"]
     if held.delta is None:
         words.append("no run left to check it on")
     else:
-        gains = ", ".join(f"{c} {held.before[c]:.1f} → {held.after[c]:.1f} %"
+        gains = ", ".join(f"{channel_words(c)} {held.before[c]:.1f} → {held.after[c]:.1f} %"
                           for c in held.after)
         change = f"better by {-held.delta:.0f}" if held.delta < 0 else \
             f"worse by {held.delta:.0f}"
@@ -450,7 +452,7 @@ def _evidence(candidate: Candidate, delta_bic: float, held: HeldOut,
         if held.denoised:
             channel, clean_before, clean_after = held.denoised
             words.append(f"below {DENOISED_HZ:g} Hz, where the logger's noise is out, "
-                         f"{channel} {clean_before:.1f} → {clean_after:.1f} %")
+                         f"{channel_words(channel)} {clean_before:.1f} → {clean_after:.1f} %")
     related = [s.describe() for s in signatures
                if s.channel in candidate.channels and not s.tentative]
     if related:

@@ -18,7 +18,7 @@ import matplotlib.pyplot as plt
 import matplotlib.ticker
 import numpy as np
 
-from landing_gear_sim.calibration.measured import CHANNELS
+from landing_gear_sim.calibration.measured import channel_words
 from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
 from landing_gear_sim.diagnosis.relations import Z_VIOLATED, Check, Relation
 from landing_gear_sim.diagnosis.residuals import Spectrum
@@ -31,8 +31,12 @@ from landing_gear_sim.report.local import local_gain_section
 from landing_gear_sim.report.pages import html_image, html_table, text_table, write_html
 from landing_gear_sim.report.words import (
     candidate_values,
+    evidence_class,
+    fits_words,
     headline,
+    held_out_words,
     parameters_text,
+    title_words,
     verdict_text,
 )
 from msg_tools.run import Run
@@ -49,7 +53,7 @@ def plot_before_after(measured: Run, before: Run, after: Run, channels: Sequence
     for i, channel in enumerate(channels):
         factor, unit = DISPLAY_UNITS[channel]
         y = getattr(measured, channel)
-        label = CHANNELS[channel].split(" [")[0]
+        label = channel_words(channel)
         top, bottom = axes[2 * i, 0], axes[2 * i + 1, 0]
         top.plot(t, y * factor, "k", lw=0.6, label="measured")
         top.plot(t, getattr(before, channel) * factor, "b", lw=0.8, label="starting model")
@@ -100,7 +104,16 @@ def psd_unit(unit: str) -> str:
 def write_diagnosis_report(result: Diagnosis, folder: Path) -> Path:
     """The diagnosis page ``folder/index.html`` with its figures; returns the page."""
     sections = diagnosis_sections(result, folder)
-    return write_html(folder / "index.html", f"Diagnosis: {verdict_text(result)}", sections)
+    best = result.findings[0] if result.findings else None
+    title = title_words(best, result.verdict)
+    return write_html(folder / "index.html", f"Diagnosis: {title[0].upper()}{title[1:]}",
+                      sections, first_screen=3 if result.problems else 2)
+
+
+BASELINE_DEFINITION = (
+    "<p>The calibrated starting model's fit on <i>every</i> run of the campaign. A finding's "
+    "“held-out fit before” is the same model's fit on the runs that finding was checked on "
+    "only, not fitted on: a smaller set, hence another number.</p>")
 
 
 def _structure_table(result: Diagnosis) -> str:
@@ -117,22 +130,20 @@ def _structure_table(result: Diagnosis) -> str:
 def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]:
     """HTML sections of the diagnosis page; figures are written into ``folder``. Draws the
     simulations and spectra the diagnosis kept (``result.evidence``), computes nothing."""
-    def fits(values: dict[str, float]) -> str:
-        return ", ".join(f"{c}: {v:.2f} %" for c, v in values.items())
-
     findings = html_table(
-        ["cause", "parameters ± 1σ", "ΔBIC", "held-out improvement", "held-out fit before",
-         "after", "evidence"],
+        ["cause", "parameters ± 1σ", "evidence (ΔBIC)", "on the held-out runs",
+         "held-out fit before", "after", "held-out log-likelihood gain", "evidence"],
         [[f.cause + (f" ({f.family}): {f.term}" if f.term else "")
-          + (f" — in the {f.equation} ({f.channel})" if f.equation else ""),
-          parameters_text(f),
-          _text(f.delta_bic), _text(_gain(f.held_out)), fits(f.fit_before), fits(f.fit_after),
+          + (f" — in the {f.equation} ({channel_words(f.channel)})" if f.equation else ""),
+          parameters_text(f), evidence_class(f.delta_bic),
+          held_out_words(f).removeprefix("on the runs it was not fitted on ") or "-",
+          fits_words(f.fit_before), fits_words(f.fit_after), _text(_gain(f.held_out)),
           f.evidence] for f in result.findings])
     candidates = html_table(
-        ["round", "cause", "accepted", "why", "key parameters", "ΔBIC", "held-out improvement",
-         "fitted on", "checked on"],
+        ["round", "cause", "accepted", "why", "key parameters", "evidence (ΔBIC)",
+         "held-out log-likelihood gain", "fitted on", "checked on"],
         [[str(f.round or "discovery"), f.cause, "yes" if f.accepted else "no", f.reason,
-          candidate_values(f, result.findings), _text(f.delta_bic),
+          candidate_values(f, result.findings), evidence_class(f.delta_bic),
           _text(_gain(f.held_out)), ", ".join(f.fitted_on), ", ".join(f.checked_on)]
          for f in result.candidates])
     figure = first_figure(result, folder)
@@ -142,11 +153,13 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
                "ΔBIC = BIC(with) − BIC(without) on the "
                f"fitting runs (accepted below {BIC_THRESHOLD:g}, and only if the held-out "
                f"runs improve by more than {-HELD_OUT_THRESHOLD:g} in the same "
-               f"log-likelihood units).</p>")
+               f"log-likelihood units). Its evidence class reads ΔBIC on Kass and Raftery's "
+               "scale: weak above −2, positive to −6, strong to −10, decisive beyond.</p>")
     sections = [("Verdict", verdict + (findings if result.findings else "")),
                 ("Candidates", candidates),
-                ("Starting model, calibrated: fit %", html_table(
-                    ["channel", "fit %"], [[c, f"{v:.2f}"] for c, v in result.baseline.items()])),
+                ("Starting model, calibrated: fit %", BASELINE_DEFINITION + html_table(
+                    ["channel", "fit %"], [[channel_words(c), f"{v:.2f}"]
+                                           for c, v in result.baseline.items()])),
                 ("Residual structure", _structure_table(result))]
     if result.problems:
         sections.insert(1, ("Notes", html_table(["what the diagnosis could not do"],
@@ -323,12 +336,13 @@ def _gain(held_out: float | None) -> float | None:
 def diagnosis_summary(result: Diagnosis) -> str:
     """The terminal summary: candidates, baseline fit, verdict, findings, notes."""
     rows = [[str(f.round or "disc."), f.cause, "yes" if f.accepted else "no",
-             _text(f.delta_bic), _text(_gain(f.held_out)),
+             evidence_class(f.delta_bic), _text(_gain(f.held_out)),
              f"{_fits(f.fit_before)} -> {_fits(f.fit_after)}", f.reason]
             for f in result.candidates]
-    lines = ["candidates:", text_table(["round", "cause", "accepted", "dBIC", "held-out gain",
-                                        "held-out fit %", "why"],
-                                       rows) if rows else "  (none: the model has them all)"]
+    header = ["round", "cause", "accepted", "evidence (dBIC)", "held-out gain",
+              "held-out fit %", "why"]
+    lines = ["candidates:", text_table(header, rows) if rows
+             else "  (none: the model has them all)"]
     lines.append(f"baseline fit %: {_fits(result.baseline)}")
     lines.append(f"VERDICT: {verdict_text(result)}")
     lines.append(f"  {headline(result)}")
@@ -340,7 +354,7 @@ def diagnosis_summary(result: Diagnosis) -> str:
     for i, f in enumerate(result.findings):
         lines.append(f"  {f.cause}" + (f" ({f.family})" if f.family else "") + ":")
         if f.equation:
-            lines.append(f"    where: the {f.equation} (seen in {f.channel})")
+            lines.append(f"    where: the {f.equation} (seen in the {channel_words(f.channel)})")
         if i and f.fit_after and f.fit_after != f.fit_before:
             gain = ", ".join(f"{c} {f.fit_before[c]:.2f} -> {f.fit_after[c]:.2f} %"
                              for c in f.fit_after)

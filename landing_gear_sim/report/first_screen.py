@@ -11,10 +11,10 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
+from landing_gear_sim.calibration.measured import channel_words
 from landing_gear_sim.diagnosis.diagnose import Diagnosis
 from landing_gear_sim.diagnosis.signatures import RunEvidence
 from landing_gear_sim.report.figures import DISPLAY_UNITS, save_figure
-from landing_gear_sim.report.words import channel_words
 
 SMOOTHING_S = 0.2  # the residual's envelope: a noise spike is not where the model misses
 MIN_HALF_WINDOW_S = 0.5  # the window shown: at least this either side of the worst place ...
@@ -23,11 +23,13 @@ RUN_SHARE = 0.05  # ... or this share of the run
 
 @dataclass(frozen=True)
 class Misfit:
-    """Where to look: a run's evidence, the channel and the window [samples]."""
+    """Where to look: a run's evidence, the channel, the window [samples], and whether the
+    verdict's finding was checked on that run rather than fitted on it."""
 
     evidence: RunEvidence
     channel: str
     window: slice
+    held_out: bool = False
 
 
 def misfit_channel(result: Diagnosis) -> str | None:
@@ -43,19 +45,28 @@ def misfit_channel(result: Diagnosis) -> str | None:
     return best.channel if best.channel in DISPLAY_UNITS else None
 
 
+def held_out_runs(result: Diagnosis) -> set[str]:
+    """The runs the verdict's finding was checked on, not fitted on (a run cut in time,
+    'stop (2.0-9.0 s)', as its whole run)."""
+    best = result.findings[0] if result.findings else None
+    return {name.split(" (")[0] for name in best.checked_on} if best else set()
+
+
 def worst_misfit(result: Diagnosis) -> Misfit | None:
     """The run and window where the starting model misses the verdict's channel most (for a
-    verdict naming none, the channel each run's spectrum was taken on)."""
+    verdict naming none, the channel each run's spectrum was taken on), among the runs the
+    verdict's finding was checked on where it has any: the headline's gain is theirs."""
     named = misfit_channel(result)
-    best: tuple[float, Misfit] | None = None
+    held = held_out_runs(result)
+    best: tuple[tuple[bool, float], Misfit] | None = None
     for item in result.evidence:
         channel = named or item.channel
         if channel not in DISPLAY_UNITS or (channel != "pressure_pa" and not item.run.braking):
             continue
         miss = getattr(item.run, channel) - getattr(item.before, channel)
-        size = float(np.sqrt(np.mean(miss ** 2)))
-        if best is None or size > best[0]:
-            best = (size, Misfit(item, channel, _window(item.run.time_s, miss)))
+        rank = (item.run.name in held, float(np.sqrt(np.mean(miss ** 2))))
+        if best is None or rank > best[0]:
+            best = (rank, Misfit(item, channel, _window(item.run.time_s, miss), rank[0]))
     return None if best is None else best[1]
 
 
@@ -69,8 +80,9 @@ def _window(time_s: np.ndarray, miss: np.ndarray) -> slice:
 
 
 def plot_misfit(misfit: Misfit, path: Path) -> Path:
-    """The measured channel (black), the starting model (blue) and the extended one (red)
-    in the window, the residuals below; the legend under the axes, off the data."""
+    """The measured channel (thin black, drawn last: on top) over the starting model (blue)
+    and the extended one (red, both wide and pale) in the window, the residuals of both
+    below; the legend under the axes, off the data."""
     item, channel, span = misfit.evidence, misfit.channel, misfit.window
     factor, unit = DISPLAY_UNITS[channel]
     t = item.run.time_s[span] - item.run.time_s[0]
@@ -80,9 +92,9 @@ def plot_misfit(misfit: Misfit, path: Path) -> Path:
     for model, colour, label in ((item.before, "tab:blue", "starting model"),
                                  (item.after, "tab:red", "extended model")):
         simulated = getattr(model, channel)[span]
-        top.plot(t, simulated * factor, color=colour, lw=1.0, label=label)
+        top.plot(t, simulated * factor, color=colour, lw=2.4, alpha=0.55, label=label)
         bottom.plot(t, (measured - simulated) * factor, color=colour, lw=0.7)
-    top.plot(t, measured * factor, "k", lw=0.6, label="measured", zorder=1)
+    top.plot(t, measured * factor, "k", lw=0.7, label="measured", zorder=3)
     label = channel_words(channel)
     top.set_ylabel(f"{label} [{unit}]")
     bottom.set_ylabel(f"measured − model\n[{unit}]")
@@ -90,7 +102,9 @@ def plot_misfit(misfit: Misfit, path: Path) -> Path:
     bottom.set_xlabel(f"time in {item.run.name} [s]")
     for axis in (top, bottom):
         axis.grid(alpha=0.3)
-    fig.suptitle(f"{item.run.name}: {label} where the starting model misses most", fontsize=11)
+    role = "held out" if misfit.held_out else "a fitting run"
+    fig.suptitle(f"{item.run.name}, {role}: {label} where the starting model misses most",
+                 fontsize=11)
     fig.legend(loc="outside lower center", ncol=3, fontsize=8)
     return save_figure(fig, path)
 

@@ -16,18 +16,35 @@ def text_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     return "\n".join(lines)
 
 
-def write_html(path: Path, title: str, sections: Sequence[tuple[str, str]]) -> Path:
-    """One self-contained page (figures next to it); ``sections`` are (heading, html body)."""
-    body = "\n".join(f"<h2>{html.escape(h)}</h2>\n{b}" for h, b in sections)
+def write_html(path: Path, title: str, sections: Sequence[tuple[str, str]],
+               first_screen: int | None = None) -> Path:
+    """One self-contained page (figures next to it); ``sections`` are (heading, html body).
+    With ``first_screen``, the sections after that many are folded, each opened from a link
+    at the top: the page had run past 16,000 px, its verdict a screen of many."""
+    shown = len(sections) if first_screen is None else first_screen
+    links = " · ".join(f"<a href='#{_anchor(h)}'>{html.escape(h)}</a>"
+                       for h, _ in sections[shown:])
+    body = "\n".join(
+        f"<h2 id='{_anchor(h)}'>{html.escape(h)}</h2>\n{b}" if i < shown else
+        f"<details id='{_anchor(h)}'><summary><h2>{html.escape(h)}</h2></summary>\n{b}"
+        "</details>" for i, (h, b) in enumerate(sections))
     page = (f"<!doctype html><html><head><meta charset='utf-8'><title>{html.escape(title)}"
             "</title><style>body{font-family:sans-serif;max-width:1100px;margin:auto}"
             "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:3px 8px;"
-            "font-size:13px}img{max-width:100%}</style></head><body>"
-            f"<h1>{html.escape(title)}</h1>\n{body}</body></html>")
+            "font-size:13px}img{max-width:100%}summary h2{display:inline;cursor:pointer}"
+            "details{margin:0.8em 0}</style><script>addEventListener('hashchange',()=>{"
+            "const d=document.getElementById(location.hash.slice(1));if(d)d.open=true})"
+            f"</script></head><body><h1>{html.escape(title)}</h1>\n"
+            + (f"<p>Further down: {links}</p>\n" if links else "")
+            + f"{body}</body></html>")
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(page)
     return path
+
+
+def _anchor(heading: str) -> str:
+    return "-".join("".join(c if c.isalnum() else " " for c in heading.lower()).split())
 
 
 def html_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
-from landing_gear_sim.calibration.measured import CHANNELS
+from landing_gear_sim.calibration.measured import channel_words
 from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
 from landing_gear_sim.diagnosis.families import REGISTRY
 from landing_gear_sim.diagnosis.findings import Finding
@@ -36,6 +36,35 @@ FAMILY_WORDS: dict[str, str] = {name: text for family in REGISTRY
 runs show'."""
 
 
+EVIDENCE_CLASSES: tuple[tuple[float, str], ...] = (
+    (-10.0, "decisive"), (-6.0, "strong"), (-2.0, "positive"), (0.0, "weak"))
+"""ΔBIC upper bounds and their evidence class for the extension (Kass & Raftery 1995: 2, 6
+and 10 units; the scoring accepts only a decisive one)."""
+
+
+def evidence_class(delta_bic: float | None) -> str:
+    """'decisive (-78.5)': the evidence ``delta_bic`` gives for the extension, its number
+    beside it, to the tenth every table writes ('-': not scored)."""
+    if delta_bic is None:
+        return "-"
+    name = next((n for bound, n in EVIDENCE_CLASSES if delta_bic <= bound), "against")
+    return f"{name} ({delta_bic:+.1f})"
+
+
+def fits_words(values: dict[str, float]) -> str:
+    """'brake pressure 97.75 %, wheel speed 99.70 %': fit % per channel, in words."""
+    return ", ".join(f"{channel_words(c)} {v:.2f} %" for c, v in values.items())
+
+
+def title_words(finding: Finding | None, verdict: str) -> str:
+    """The page's title: what the verdict found, physically ('Diagnosis: actuator_delay'
+    had been its title)."""
+    if finding is None:
+        return {"none": "nothing is missing from the model",
+                INCONCLUSIVE: "inconclusive"}.get(verdict, verdict.replace("_", " "))
+    return cause_words(finding)
+
+
 def cause_words(finding: Finding) -> str:
     """What ``finding`` is, physically, in a few words."""
     if finding.cause == "discovered":
@@ -43,11 +72,6 @@ def cause_words(finding: Finding) -> str:
         return FAMILY_WORDS.get(family, f"the {family}'s law lacks a term the runs show")
     words = CAUSE_WORDS.get(finding.cause, finding.cause.replace("_", " "))
     return f"{words} in the {finding.equation}" if finding.equation else words
-
-
-def channel_words(channel: str) -> str:
-    """A channel as the page's figures label it ('wheel speed')."""
-    return CHANNELS.get(channel, channel).split(" [")[0]
 
 
 def held_out_words(finding: Finding) -> str:
@@ -137,6 +161,10 @@ KEY_UNITS = {"s": "s", "pa": "Pa", "n": "N", "a": "A", "m": "m", "j": "J", "hz":
 """A parameter key's last word -> its SI unit (a key carries its unit, docs/parameters.md;
 ``x_per_n``: per newton)."""
 
+COMPOUND_UNITS = {"n_m_per_pa": "N m/Pa", "pa_per_a": "Pa/A", "pa_per_a2": "Pa/A^2"}
+"""A key's unit of several words -> its SI unit (``gain_n_m_per_pa`` had read
+'gain_n_m = 153.3 1/bar')."""
+
 
 def parameter_text(key: str, value: float, std: float | None, unit: str | None = None
                    ) -> str:
@@ -148,7 +176,10 @@ def parameter_text(key: str, value: float, std: float | None, unit: str | None =
         return f"{key} = {value:.4g}" + ("" if std is None else f" ± {std:.2g}")
     leaf = key.rsplit(".", 1)[-1]
     name, _, suffix = leaf.rpartition("_")
-    if unit is None:
+    compound = next((c for c in COMPOUND_UNITS if leaf.endswith(f"_{c}")), None)
+    if unit is None and compound is not None:
+        name, unit = leaf.removesuffix(f"_{compound}"), COMPOUND_UNITS[compound]
+    elif unit is None:
         unit = KEY_UNITS.get(suffix)
     else:
         name, unit = leaf, None if unit == "-" else unit

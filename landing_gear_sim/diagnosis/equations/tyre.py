@@ -27,9 +27,9 @@ from scipy.ndimage import maximum_filter1d
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration import friction
 from landing_gear_sim.calibration.friction import tyre_carries
+from landing_gear_sim.calibration.noise import channel_noise
 from landing_gear_sim.calibration.slots import Slot, seen
 from landing_gear_sim.calibration.statistics import linear_std
-from landing_gear_sim.diagnosis.catalogue import noise_std
 from landing_gear_sim.diagnosis.equations.equation import Declared, Equation
 from landing_gear_sim.diagnosis.library import (
     BrakingLibrary,
@@ -197,18 +197,6 @@ def _slip_noise(b: br.Braking, index: np.ndarray) -> np.ndarray:
     raw = channel_noise(b.run.wheel_speed_rad_s)
     filtered = raw * np.sqrt(min(1.0, 2.0 * br.FILTER_HZ / (b.run.rate_hz / 2.0)))
     return filtered / np.maximum(b.wheel[index], 1.0)
-
-
-def channel_noise(values: np.ndarray) -> float:
-    """A channel's white noise [its unit]: the robust spread of its second differences
-    (a stop's deceleration cancels out of them), or of its first where that is less (an
-    encoder's counts, mostly still between steps). First differences alone read a 200 Hz
-    log's wheel channel at 3-9 times its noise, and set the tyre's floor 5.6 times higher
-    than that noise does."""
-    second = np.diff(values, 2)
-    robust = 1.4826 * float(np.median(np.abs(second - np.median(second)))) / np.sqrt(6.0)
-    first = noise_std(values)
-    return min(first, robust) if robust > 0 else first
 
 
 TYRE = TyreLibrary()

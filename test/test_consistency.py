@@ -201,6 +201,24 @@ def test_a_brake_gain_drifting_through_the_campaign_is_discovered_as_run_drift(r
     assert finding.parameters["gain_drift_per_run"] == pytest.approx(drift, rel=0.2)
 
 
+def test_a_brake_wearing_in_another_order_than_the_pressure_steps_is_run_drift(reference,
+                                                                             tmp_path):
+    """Issue 64: wear through a campaign whose runs were made in an order of their own
+    (files `run01_…` to `run08_…`, drawn here; the constant stops no longer in rising
+    pressure) came out `discovered pressure_level`, a gain that depends on pressure: the
+    family that wins must be the one that beats the other held out."""
+    rng = np.random.default_rng(158)
+    rig = rig_like(reference, rng)
+    drift = rng.choice([-1, 1]) * rng.uniform(0.015, 0.04)
+    generate_campaign(tmp_path, rig.replace({"brake.gain_drift_per_run": drift}, "wear"), 158,
+                      shuffled=True)
+    names = sorted(p.stem for p in tmp_path.glob("*.csv"))
+    constant = [n.split("_", 1)[1] for n in names if "brake_const" in n]
+    assert constant != sorted(constant), names  # pressure steps out of run order
+    finding = _discovered_alone(diagnose(read_campaign(tmp_path).runs, reference), "run_drift")
+    assert finding.parameters["gain_drift_per_run"] == pytest.approx(drift, rel=0.2)
+
+
 def test_an_encoder_rippling_with_the_wheel_angle_is_discovered_as_wheel_angle(reference,
                                                                              tmp_path):
     """A wheel encoder reading ω (1 + e cos(mθ + φ)) (the test draws the order, 1 or 2, the

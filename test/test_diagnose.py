@@ -279,6 +279,44 @@ def test_the_extended_model_file_opens_with_the_verdict_and_what_it_measured(del
                                                                  abs=5e-6)
 
 
+_NUMBER = re.compile(r"(?<![\w.])[-−]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
+
+
+def _json_numbers(finding: dict) -> list[float]:
+    """Every number of a finding in the JSON, in SI and in the units a page shows it in (ms,
+    bar, %)."""
+    values = [*finding["parameters"].values(), *finding["uncertainty"].values(),
+              *finding["fit_before"].values(), *finding["fit_after"].values(),
+              *finding.get("rmse_before", {}).values(), *finding.get("rmse_after", {}).values()]
+    return [v * scale for v in values for scale in (1.0, 1e3, 1e-5, 100.0)]
+
+
+def _said_by_the_json(token: str, numbers: list[float]) -> bool:
+    """``token`` ('6.003', '0.29', '97.8') is one of ``numbers`` at the precision written."""
+    value = float(token.replace("−", "-"))
+    decimals = len(token.partition(".")[2])
+    return any(abs(n - value) <= 0.5 * 10 ** -decimals * (1 + 1e-9) for n in numbers)
+
+
+def test_every_number_of_the_verdict_reads_the_same_on_the_page_the_terminal_and_the_json(
+        delay_diagnosed):
+    """Issue 63, item 1: the verdict said 6.003 ms where a table said 0.005994 s, and the
+    terminal +78 where the page said +79. The headline is one sentence on the page, the
+    terminal and in the extended params file, and each of its numbers is the JSON's."""
+    page = html.unescape(delay_diagnosed.page)
+    sentence = re.search(r"<p><b>(.*?)</b></p>", page)[1]
+    assert f"  {sentence}\n" in delay_diagnosed.printed
+    header = " ".join(line.lstrip("# ") for line in delay_diagnosed.extended.read_text(
+        encoding="utf-8").splitlines() if line.startswith("#"))
+    assert sentence.split("; ")[0] in header
+    finding = delay_diagnosed.document["findings"][0]
+    numbers = _json_numbers(finding)
+    tokens = _NUMBER.findall(sentence)
+    assert len(tokens) >= 6, sentence  # delay, σ, fit before and after, RMSE before and after
+    assert all(_said_by_the_json(t, numbers) for t in tokens), (
+        [t for t in tokens if not _said_by_the_json(t, numbers)], sentence, finding)
+
+
 class _Tables(HTMLParser):
     """The page's tables by the heading of their section: rows of cell texts."""
 

@@ -7,6 +7,8 @@ import dataclasses
 import html
 import re
 
+import pytest
+
 from landing_gear_sim.diagnosis.relations import Check, Relation
 from landing_gear_sim.report.diagnosis import paired_checks
 
@@ -194,6 +196,22 @@ def test_figures_name_their_run_and_keep_their_legends_off_the_traces(reference,
     assert len(saved) == 3 and all(_legends_off_the_axes(fig) for fig in saved)
     assert all(run.name in fig.get_suptitle() for fig in saved[1:])
     assert diagnosis.psd_unit("rad/s") == "(rad/s)²/Hz" and diagnosis.psd_unit("Pa") == "Pa²/Hz"
+
+
+def test_a_pressure_residuals_spectrum_reads_in_bar_squared_per_hertz(tmp_path, monkeypatch):
+    """Issue 63: the page's spectra were in Pa²/Hz beside a verdict in bar."""
+    import numpy as np
+
+    from landing_gear_sim.diagnosis.residuals import spectrum
+    from landing_gear_sim.report import diagnosis
+
+    noise = np.random.default_rng(5).normal(0.0, 1.5e4, 20_000)  # 0.15 bar at 1 kHz
+    saved = _figures_saved(monkeypatch, diagnosis)
+    diagnosis.plot_spectrum(spectrum(noise, 1000.0), "run", "pressure_pa", tmp_path / "p.png")
+    axis = saved[0].axes[0]
+    assert axis.get_ylabel() == "PSD [bar²/Hz]"
+    level = np.median(axis.lines[0].get_ydata())  # white noise: 2σ²/f_s per Hz, one-sided
+    assert level == pytest.approx(2 * 0.15 ** 2 / 1000.0, rel=0.3)
 
 
 def test_the_local_gain_figure_keeps_its_keys_off_the_estimates(tmp_path, monkeypatch):

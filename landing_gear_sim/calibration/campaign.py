@@ -118,11 +118,13 @@ def _loaded(params: RigParameters, name: str) -> RigParameters:
 
 def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,
                       names: Sequence[str] | None = None, light: bool = False,
-                      logger: Logger | None = None) -> list[Path]:
+                      logger: Logger | None = None, shuffled: bool = False) -> list[Path]:
     """Simulate and write the standard runs of ``rig`` (or those in ``names``), with
     ``light`` the light stops too (see LIGHT_BAR), into ``folder``, as ``logger`` writes
     them (default: at the rig's output rate, nothing beyond the sensors' noise); returns
-    the CSV paths."""
+    the CSV paths. ``shuffled``: the runs were made in an order drawn from ``seed``, their
+    files named ``run01_<name>`` ... in it (a brake that wears, wears in that order; the
+    standard names put the constant stops in rising pressure)."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     logger = logger or Logger()
@@ -131,15 +133,19 @@ def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,
     if logger.rate_hz is not None:
         rig = rig.replace({K.SIMULATION_OUTPUT_RATE_HZ: logger.rate_hz}, "the logger's rate")
     scenarios = standard_scenarios(rig, light, names)
-    order = _campaign_order([n for n, s in scenarios.items() if s.contact])
+    files = {name: name for name in scenarios}
+    if shuffled:
+        made = np.random.default_rng([seed, 2]).permutation(list(scenarios))
+        files = {str(name): f"run{k:02d}_{name}" for k, name in enumerate(made, start=1)}
+    order = _campaign_order([files[n] for n, s in scenarios.items() if s.contact])
     for name, scenario in scenarios.items():
         i = STANDARD_RUNS.index(name)  # a run's noise is its own, whichever others are made
-        params = _start_angle(_loaded(run_parameters(rig, order.get(name, 0.0)), name),
+        params = _start_angle(_loaded(run_parameters(rig, order.get(files[name], 0.0)), name),
                               np.random.default_rng([seed, i]))
         result = simulate(params, scenario)
         run = logger.write(result, result.to_run(noise=seed * 100 + i),
                            np.random.default_rng([seed, i, 1]))
-        path = folder / f"{name}.csv"
+        path = folder / f"{files[name]}.csv"
         write_csv(run, path)
         written.append(path)
     return written

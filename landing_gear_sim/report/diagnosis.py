@@ -71,20 +71,23 @@ def plot_before_after(measured: Run, before: Run, after: Run, channels: Sequence
     return save_figure(fig, path)
 
 
-def plot_spectrum(spectrum: Spectrum, title: str, unit: str, path: Path) -> Path:
-    """Residual PSD, its noise floor, the detection threshold and the detected lines."""
+def plot_spectrum(spectrum: Spectrum, title: str, channel: str, path: Path) -> Path:
+    """Residual PSD, its noise floor, the detection threshold and the detected lines, in the
+    channel's display unit squared per Hz (bar²/Hz: the page had read Pa²/Hz)."""
+    factor, unit = DISPLAY_UNITS[channel]
     f = spectrum.frequency_hz
+    psd, floor = spectrum.psd * factor ** 2, spectrum.floor * factor ** 2
     band = f > 0
     fig, axis = plt.subplots(figsize=(8, 3.8))
-    axis.loglog(f[band], spectrum.psd[band], "k", lw=0.7, label="residual PSD")
-    finite = band & np.isfinite(spectrum.floor)
-    axis.loglog(f[finite], spectrum.floor[finite], "g", lw=0.8, label="noise floor")
-    axis.loglog(f[finite], spectrum.floor[finite] * spectrum.threshold, "g--", lw=0.6,
+    axis.loglog(f[band], psd[band], "k", lw=0.7, label="residual PSD")
+    finite = band & np.isfinite(floor)
+    axis.loglog(f[finite], floor[finite], "g", lw=0.8, label="noise floor")
+    axis.loglog(f[finite], floor[finite] * spectrum.threshold, "g--", lw=0.6,
                 label="detection threshold (1 % family-wise)")
     for peak in spectrum.peaks[:5]:
         i = int(np.argmin(np.abs(f - peak.frequency_hz)))
-        axis.plot(f[i], spectrum.psd[i], "rv", ms=8)
-        axis.annotate(f"{peak.frequency_hz:.2f} Hz", (f[i], spectrum.psd[i]), fontsize=8,
+        axis.plot(f[i], psd[i], "rv", ms=8)
+        axis.annotate(f"{peak.frequency_hz:.2f} Hz", (f[i], psd[i]), fontsize=8,
                       xytext=(4, 6), textcoords="offset points", color="r")
     axis.set_xlabel("frequency [Hz]")
     axis.set_ylabel(f"PSD [{psd_unit(unit)}]")
@@ -177,9 +180,8 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
                                    folder / f"{run.name}.png")
         body = html_image(figure, folder)
         if item.spectrum is not None:
-            unit = "Pa" if item.channel == "pressure_pa" else "rad/s"
-            figure = plot_spectrum(item.spectrum, f"{run.name}: {item.channel} residual of the "
-                                   "calibrated starting model", unit,
+            figure = plot_spectrum(item.spectrum, f"{run.name}: {channel_words(item.channel)} "
+                                   "residual of the calibrated starting model", item.channel,
                                    folder / f"{run.name}_spectrum.png")
             body += html_image(figure, folder)
         sections.append((f"{run.name} ({run.kind})", body))

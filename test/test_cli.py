@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from landing_gear_sim.calibration.campaign import STANDARD_RUNS
 from landing_gear_sim.cli import build_parser, main
 from landing_gear_sim.model.parameters import load_parameters
 from msg_tools.bag_read import read_bag
@@ -269,3 +270,13 @@ def test_the_compile_note_is_printed_only_while_compiling(tmp_path, capsys):
     assert main([*argv, "-o", str(tmp_path / "b.csv")]) == 0
     err = capsys.readouterr().err
     assert "simulated in" in err and "compil" not in err
+
+
+def test_a_shuffled_campaign_names_its_runs_in_the_order_they_were_made(tmp_path):
+    """Issue 64: wear is judged by run order; a campaign made out of pressure order is
+    what tells a brake that wears from a gain that depends on pressure."""
+    assert main(["campaign", str(tmp_path / "c"), "--shuffled", "--seed", "158"]) == 0
+    names = sorted(p.stem for p in (tmp_path / "c").glob("*.csv"))
+    assert [n[:6] for n in names] == [f"run{k:02d}_" for k in range(1, 9)]
+    made = [n[6:] for n in names]
+    assert sorted(made) == sorted(STANDARD_RUNS[:8]) and made != sorted(made)

@@ -553,7 +553,7 @@ def test_a_cause_that_makes_a_compared_channel_worse_held_out_is_not_named(refer
     result = diagnose(read_campaign(tmp_path).runs, reference)
     assert result.verdict not in CATALOGUE, result.verdict
     relaxation = next(f for f in result.candidates if f.cause == "tire_relaxation")
-    assert "wheel_speed_rad_s worse" in relaxation.reason, relaxation.reason
+    assert "wheel speed worse" in relaxation.reason, relaxation.reason
     # nor `none` (stop 55 to 56) nor `unexplained` (stop 57): its locks slide with less grip
     # the faster, and the tyre's terms read there, where the slip is 1 through any encoder
     found = _first(result, "tyre")

@@ -110,6 +110,10 @@ def _add_campaign(sub: argparse._SubParsersAction) -> None:
     gen.add_argument("--light-runs", action="store_true",
                      help="also brake three stops at 70 %% of the static load (14, 21, 28 bar): "
                           "what shows a tyre's friction changing with the load")
+    gen.add_argument("--shuffled", action="store_true",
+                     help="make the runs in an order drawn from the seed, named run01_... in "
+                          "it (a brake that wears, with --set brake.gain_drift_per_run=-0.03, "
+                          "wears in that order)")
     gen.set_defaults(func=cmd_campaign)
 
 
@@ -303,7 +307,7 @@ def cmd_campaign(args: argparse.Namespace) -> int:
     progress(f"simulating a synthetic campaign (seed {args.seed}, datasheet "
               f"±{100 * args.deviation:g} %{realities})")
     for path in generate_campaign(args.output, rig, args.seed, light=args.light_runs,
-                                  logger=logger):
+                                  logger=logger, shuffled=args.shuffled):
         print(f"  {path}")
     print(f"generating parameters (for checks only): {args.output / GENERATING_FILE}")
     return 0

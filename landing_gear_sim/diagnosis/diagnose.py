@@ -43,6 +43,7 @@ from landing_gear_sim.diagnosis.equations.placing import locate_all
 from landing_gear_sim.diagnosis.findings import Finding, Signature
 from landing_gear_sim.diagnosis.identifiability import actuator_calibrated, untestable
 from landing_gear_sim.diagnosis.local import LocalGain, local_gains
+from landing_gear_sim.diagnosis.misfit import misfit_finding, misfits
 from landing_gear_sim.diagnosis.relations import Check, structural
 from landing_gear_sim.diagnosis.rig_bounds import scaled_to_rig
 from landing_gear_sim.diagnosis.scoring import (
@@ -279,6 +280,8 @@ def _verdict(start: _Start, table: list[Finding], accepted: list[Scored],
         findings.append(unexplained(after, baseline_fits(start.runs, simulated_after), places))
     if broken := structural(checks):
         findings.append(inconsistent(broken))
+    if not findings and (missed := misfits(start.runs, simulated_after)):
+        findings.append(misfit_finding(missed, baseline_fits(start.runs, simulated_after)))
     return (findings[0].cause if findings else "none"), findings
 
 

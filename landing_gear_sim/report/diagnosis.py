@@ -358,7 +358,7 @@ def diagnosis_summary(result: Diagnosis) -> str:
         if f.equation:
             lines.append(f"    where: the {f.equation} (seen in the {channel_words(f.channel)})")
         if i and f.fit_after and f.fit_after != f.fit_before:
-            gain = ", ".join(f"{c} {f.fit_before[c]:.2f} -> {f.fit_after[c]:.2f} %"
+            gain = ", ".join(f"{channel_words(c)} {f.fit_before[c]:.2f} -> {f.fit_after[c]:.2f} %"
                              for c in f.fit_after)
             lines.append(f"    held-out gain: {gain}")
         lines.append(f"    evidence: {f.evidence}")

@@ -83,3 +83,29 @@ def test_one_run_of_three_missed_is_that_runs_moment_two_are_a_missing_law(stop)
     assert misfits(runs, [model] * 3) == []
     runs[1] = dataclasses.replace(missed, name="stop_1")
     assert [m.run for m in misfits(runs, [model] * 3)] == ["stop_0", "stop_1"]
+
+
+def test_a_discovered_law_its_equation_still_misses_reads_approximately(reference, tmp_path):
+    """Issue 64, item 5: a grip changing sharply near standstill read as sgn ω plus √v, with an
+    `unexplained` left in the same equation, and the law was stated as if exact."""
+    from landing_gear_sim.diagnosis.diagnose import Diagnosis
+    from landing_gear_sim.diagnosis.families import EQUATIONS
+    from landing_gear_sim.diagnosis.findings import Finding, approximations
+    from landing_gear_sim.report.words import headline
+
+    def finding(cause: str, family: str = "", equation: str = "") -> Finding:
+        return Finding(cause=cause, parameters={}, std={}, evidence="", fit_before={},
+                       fit_after={}, delta_bic=None, held_out=None, accepted=True,
+                       family=family, term="μ = μ_B(λ) + 0.02·sgn ω" if family else "",
+                       equation=equation)
+
+    tyre, wheel = finding("discovered", "tyre"), finding("discovered", "wheel")
+    left = finding("unexplained", equation="tyre")
+    marked = approximations([tyre, wheel, left], EQUATIONS)
+    assert [f.approximate for f in marked] == [True, False, False]
+    assert not approximations([tyre], EQUATIONS)[0].approximate
+    assert marked[0].to_json()["approximate"] is True and "approximate" not in wheel.to_json()
+    result = Diagnosis(verdict="discovered", findings=marked, candidates=[], baseline={},
+                       start=reference, calibrated=reference, extended=reference,
+                       signatures_before=[], signatures_after=[])
+    assert "approximately μ = μ_B(λ) + 0.02·sgn ω" in headline(result)

@@ -40,7 +40,8 @@ from landing_gear_sim.diagnosis.consistency import (
     under_floor,
 )
 from landing_gear_sim.diagnosis.equations.placing import locate_all
-from landing_gear_sim.diagnosis.findings import Finding, Signature
+from landing_gear_sim.diagnosis.families import EQUATIONS
+from landing_gear_sim.diagnosis.findings import Finding, Signature, approximations
 from landing_gear_sim.diagnosis.identifiability import actuator_calibrated, untestable
 from landing_gear_sim.diagnosis.local import LocalGain, local_gains
 from landing_gear_sim.diagnosis.misfit import misfit_finding, misfits
@@ -282,6 +283,7 @@ def _verdict(start: _Start, table: list[Finding], accepted: list[Scored],
         findings.append(inconsistent(broken))
     if not findings and (missed := misfits(start.runs, simulated_after)):
         findings.append(misfit_finding(missed, baseline_fits(start.runs, simulated_after)))
+    findings = approximations(findings, EQUATIONS)
     return (findings[0].cause if findings else "none"), findings
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 from dataclasses import dataclass, field
 
@@ -64,6 +65,10 @@ class Finding:
     units: dict[str, str] = field(default_factory=dict)
     """The SI unit of a parameter whose key does not carry one (an ``unexplained``
     finding's deviation, in its relation's unit; '-': a ratio)."""
+    approximate: bool = False
+    """A ``discovered`` law whose own equation still shows what the final model misses (an
+    ``unexplained`` finding there): it approximates the rig's law, and that finding says
+    where it misses."""
 
     def to_json(self) -> dict[str, object]:
         document: dict[str, object] = {"cause": self.cause, "parameters": self.parameters,
@@ -81,7 +86,18 @@ class Finding:
             document |= {"equation": self.equation, "channel": self.channel}
         if self.units:
             document |= {"units": self.units}
+        if self.approximate:
+            document |= {"approximate": True}
         return document
+
+
+def approximations(findings: list[Finding], equations: dict[str, str]) -> list[Finding]:
+    """``findings`` with each discovered law marked approximate where an ``unexplained``
+    finding lives in the equation it extends (``equations``: a family -> its equation)."""
+    missed = {f.equation for f in findings if f.cause == "unexplained"}
+    return [dataclasses.replace(f, approximate=True)
+            if f.cause == "discovered" and equations.get(f.family) in missed else f
+            for f in findings]
 
 
 @dataclass(frozen=True)

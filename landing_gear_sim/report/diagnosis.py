@@ -136,7 +136,8 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
     findings = html_table(
         ["cause", "parameters ± 1σ", "evidence (ΔBIC)", "on the held-out runs",
          "held-out fit before", "after", "held-out log-likelihood gain", "evidence"],
-        [[f.cause + (f" ({f.family}): {f.term}" if f.term else "")
+        [[f.cause + (f" ({f.family}): {'approximately ' * f.approximate}{f.term}"
+                     if f.term else "")
           + (f" — in the {f.equation} ({channel_words(f.channel)})" if f.equation else ""),
           parameters_text(f), evidence_class(f.delta_bic),
           held_out_words(f).removeprefix("on the runs it was not fitted on ") or "-",

@@ -125,7 +125,9 @@ def finding_sentence(finding: Finding, verdict: str, gain: bool = True) -> str:
     held-out gain."""
     values = parameters_text(finding)
     if finding.term:
-        said = f"{cause_words(finding)}, {finding.term}" + (f" ({values})" if values else "")
+        # an unexplained finding in its equation follows, saying where the law misses
+        law = f"approximately {finding.term}" if finding.approximate else finding.term
+        said = f"{cause_words(finding)}, {law}" + (f" ({values})" if values else "")
     else:
         said = cause_words(finding) + (f", {values}" if values else "")
     gained = held_out_words(finding) if gain else ""

@@ -65,4 +65,8 @@ HIDDEN: dict[str, tuple[Family, Hidden]] = {
     h.name: (f, h) for f in REGISTRY for h in f.hidden}
 """Every family's hidden effects by case name (tests, bench/detection.py)."""
 
-__all__ = ["DISCOVERED", "HIDDEN", "REGISTRY", "Evidence", "Family", "Hidden", "Proposal"]
+EQUATIONS: dict[str, str] = {f.reports: f.equation for f in REGISTRY}
+"""The equation each family's discovered findings extend, by the family they report."""
+
+__all__ = ["DISCOVERED", "EQUATIONS", "HIDDEN", "REGISTRY", "Evidence", "Family", "Hidden",
+           "Proposal"]

@@ -64,6 +64,11 @@ class Score:
         """RMSE within the tolerance (False where the noise is unknown)."""
         return self.rmse <= self.tolerance
 
+    @property
+    def in_noise(self) -> float:
+        """RMSE over the noise (inf where the noise is unknown or nil)."""
+        return self.rmse / self.noise if self.noise > 0 else float("inf")
+
 
 @dataclass(frozen=True)
 class RunComparison:
@@ -114,16 +119,11 @@ def channel_verdicts(comparisons: Sequence[RunComparison]) -> list[ChannelVerdic
                   if channel in c.scores]
         if not scored:
             continue
-        worst_run, worst = max(scored, key=lambda item: _in_noise(item[1]))
+        worst_run, worst = max(scored, key=lambda item: item[1].in_noise)
         verdicts.append(ChannelVerdict(channel, tuple(name for name, _ in scored),
                                        tuple(name for name, s in scored if not s.passed),
                                        worst_run, worst))
     return verdicts
-
-
-def _in_noise(score: Score) -> float:
-    """RMSE over the noise (inf where the noise is unknown or nil)."""
-    return score.rmse / score.noise if score.noise > 0 else float("inf")
 
 
 def fit_percent(measured: np.ndarray, simulated: np.ndarray) -> float:

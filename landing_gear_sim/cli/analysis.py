@@ -201,9 +201,10 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
+    from landing_gear_sim.calibration.measured import channel_words
     from landing_gear_sim.calibration.plausibility import check_units
     from landing_gear_sim.calibration.runs import classified
-    from landing_gear_sim.calibration.validate import compare
+    from landing_gear_sim.calibration.validate import NOISE_MULTIPLE, compare
     from landing_gear_sim.report.figures import DISPLAY_UNITS
     from landing_gear_sim.report.pages import text_table
     from landing_gear_sim.report.validation import plot_overlay
@@ -217,9 +218,11 @@ def cmd_compare(args: argparse.Namespace) -> int:
     rows = []
     for channel, score in comparison.scores.items():
         factor, unit = DISPLAY_UNITS[channel]  # as the plot shows it (issue 32: Pa and N)
-        rows.append([channel, f"{score.fit_percent:.2f}", f"{score.rmse * factor:.4g} {unit}",
-                     f"{score.max_error * factor:.4g} {unit}"])
-    print(text_table(["channel", "fit %", "RMSE", "max |error|"], rows))
+        rows.append([channel_words(channel), f"{score.fit_percent:.2f}",
+                     f"{score.rmse * factor:.4g} {unit}", f"{score.max_error * factor:.4g} {unit}",
+                     f"{score.in_noise:.3g} × noise: {'pass' if score.passed else 'FAIL'}"])
+    print(text_table(["channel", "fit %", "RMSE", "max |error|",
+                      f"RMSE within {NOISE_MULTIPLE:g} × the logger's noise"], rows))
     print(f"plot: {plot_overlay(comparison, args.plot)}")
     return 0
 

@@ -29,8 +29,7 @@ MISFIT_MULTIPLE = 4.0
 """A channel's RMSE over its noise past which the model misses it on a run. The final
 model of the shared nulls (2 kHz, 200 Hz, a noisy current, a 64-count encoder, another rig)
 and of campaign_v2 reads at most 2.7 on any run and channel (the validation's pass is 3), an
-own null at 200 Hz through a noisy ADC 4.2 on one run of six; a starting model that fits a
-pressure at 87 % where nulls fit 97-99 % reads about 9."""
+own null at 200 Hz through a noisy ADC 4.2 on one run of six."""
 ENVELOPE_S = 0.2  # the residual's running RMS: where it misses, not where a spike is
 SI_UNITS = {"pressure_pa": "Pa", "wheel_speed_rad_s": "rad/s", "flywheel_speed_rad_s": "rad/s",
             "vertical_load_n": "N", "longitudinal_force_n": "N"}

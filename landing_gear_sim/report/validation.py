@@ -153,7 +153,7 @@ def _miss(verdict: ChannelVerdict) -> str:
     worst = verdict.worst
     return (f"the {channel_words(verdict.channel)} on {len(verdict.failed)} of "
             f"{len(verdict.runs)} runs (worst {verdict.worst_run}: RMSE "
-            f"{_shown(verdict.channel, worst.rmse)}, {worst.rmse / worst.noise:.1f} times its "
+            f"{_shown(verdict.channel, worst.rmse)}, {worst.in_noise:.1f} times its "
             f"noise of {_shown(verdict.channel, worst.noise)})")
 
 
@@ -192,8 +192,7 @@ def noise_table(comparisons: Sequence[RunComparison]) -> tuple[list[str], list[l
     """Header and rows: per run and channel, the RMSE in multiples of that run's noise,
     pass or fail ('' where not scored)."""
     def cell(score: Score) -> str:
-        ratio = score.rmse / score.noise if score.noise > 0 else float("inf")
-        return f"{ratio:.1f} × noise {'pass' if score.passed else 'FAIL'}"
+        return f"{score.in_noise:.1f} × noise {'pass' if score.passed else 'FAIL'}"
 
     header = ["run", *(channel_words(c) for c in CHANNELS)]
     return header, [[c.measured.name, *(cell(c.scores[ch]) if ch in c.scores else ""

@@ -28,9 +28,13 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line("markers", "slow: minutes-long diagnosis cases (make test-slow)")
+    config.addinivalue_line("markers", "long: a test of a minute or more, started first")
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    # the longest first: collected last, the README's whole list (~2 min) had run alone on
+    # one core while the other had finished
+    items.sort(key=lambda item: "long" not in item.keywords)
     if config.getoption("--slow"):
         return
     skip = pytest.mark.skip(reason="slow diagnosis case: run with --slow (make test-slow)")

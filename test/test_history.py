@@ -138,6 +138,7 @@ def _wait_for(condition, timeout_s: float, what: str) -> None:
         time.sleep(0.1)
 
 
+@pytest.mark.long
 def test_a_worker_killed_mid_run_loses_nothing(history, identified_history, tmp_path):
     """A real `dask scheduler` and two `dask worker` processes on 127.0.0.1; one worker is
     killed once the first campaign is in: the table is complete and identical to that of

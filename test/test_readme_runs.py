@@ -33,6 +33,7 @@ def test_the_readme_lists_its_main_uses():
                                     or "out/rig_threshold" in line for line in LINES), LINES
 
 
+@pytest.mark.long
 def test_every_readme_line_runs_in_a_fresh_folder_and_writes_under_out_mine(tmp_path,
                                                                             monkeypatch):
     """The whole list in order (the demo's out/rig_threshold made first, as the README's

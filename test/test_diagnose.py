@@ -486,7 +486,7 @@ def test_a_discovered_term_is_said_as_its_equations_law(reference):
                        signatures_before=[], signatures_after=[])
     assert headline(result) == (
         "discovered tyre: the tyre's law lacks a term the runs show, μ = μ_B(λ)·g(F_z) + "
-        "0.489·μ_B² (μ_B² = 0.489 ± 0.0034); on the runs it was not fitted on the wheel speed "
+        "0.489·μ_B² (μ_B² ± 0.7 %); on the runs it was not fitted on the wheel speed "
         "fits 98.4 → 98.7 %.")
     # issue 42: the gain in the channel's own unit too
     measured = dataclasses.replace(found, rmse_before={"wheel_speed_rad_s": 1.234},

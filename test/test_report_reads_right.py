@@ -357,3 +357,20 @@ def test_the_page_speaks_in_the_engineers_words_and_units(reference, tmp_path):
     assert "decisive (-78.5)" in tables and "weak (-1.2)" in tables
     assert "brake pressure fits 97.8 → 98.5 % (RMSE 0.3 → 0.15 bar)" in tables
     assert "on <i>every</i> run of the campaign" in page  # what the baseline fit measures
+
+
+def test_a_discovered_law_reads_its_coefficients_once_in_engineering_units(reference):
+    """Issue 63: U03's verdict wrote its law in bar, '+ 0.0585 1/bar·P·ΔP', then the same
+    coefficients in SI beside it, '(P·ΔP = 5.853e-07 ± 7e-09, …)'."""
+    from landing_gear_sim.diagnosis.diagnose import Diagnosis
+    from landing_gear_sim.diagnosis.findings import Finding
+    from landing_gear_sim.report.words import headline
+
+    found = Finding(cause="discovered", parameters={"P·ΔP": 5.853e-7, "P·Ṗ": -3.204e-9},
+                    std={"P·ΔP": 7e-9, "P·Ṗ": 7e-11}, evidence="", fit_before={},
+                    fit_after={}, delta_bic=-50.0, held_out=-80.0, accepted=True,
+                    family="valve", term="P̈ = ω_n²·(μ·P_static − P + 0.0585 1/bar·P·ΔP)")
+    said = headline(Diagnosis(verdict="discovered", findings=[found], candidates=[],
+                              baseline={}, start=reference, calibrated=reference,
+                              extended=reference, signatures_before=[], signatures_after=[]))
+    assert "(P·ΔP ± 1.2 %, P·Ṗ ± 2.2 %)" in said and "e-07" not in said, said

@@ -104,6 +104,20 @@ def parameters_text(finding: Finding) -> str:
                      for k, v in finding.parameters.items())
 
 
+def law_values(finding: Finding) -> str:
+    """Beside a law written out with its values in engineering units: a named parameter as
+    it reads, a term's coefficient by its 1-σ relative to it ('P·ΔP ± 1.2 %'; its SI value,
+    'P·ΔP = 5.853e-07 ± 7e-09', had stood beside the law's '0.0585 1/bar·P·ΔP')."""
+    said = []
+    for key, value in finding.parameters.items():
+        std = finding.std.get(key)
+        if re.fullmatch(r"[a-z0-9_.]+", key):  # a contract name: its unit in its words
+            said.append(parameter_text(key, value, std, finding.units.get(key)))
+        elif std is not None and value:
+            said.append(f"{key} ± {100 * std / abs(value):.2g} %")
+    return ", ".join(said)
+
+
 def candidate_values(candidate: Finding, findings: Sequence[Finding]) -> str:
     """A candidate's parameters as the verdict states them: the final values of the finding
     it became (re-calibrated after its round), and its round's own only where they differ,
@@ -127,6 +141,7 @@ def finding_sentence(finding: Finding, verdict: str, gain: bool = True) -> str:
     if finding.term:
         # an unexplained finding in its equation follows, saying where the law misses
         law = f"approximately {finding.term}" if finding.approximate else finding.term
+        values = law_values(finding)
         said = f"{cause_words(finding)}, {law}" + (f" ({values})" if values else "")
     else:
         said = cause_words(finding) + (f", {values}" if values else "")

@@ -128,6 +128,7 @@ def test_the_first_screen_draws_a_held_out_run_with_the_measured_trace_on_top(
     from landing_gear_sim.calibration.runs import classified
     from landing_gear_sim.diagnosis.diagnose import Diagnosis
     from landing_gear_sim.diagnosis.findings import Finding
+    from landing_gear_sim.diagnosis.scoring import CUT_LATER, part_name
     from landing_gear_sim.diagnosis.signatures import RunEvidence
     from landing_gear_sim.model import scenario as sc
     from landing_gear_sim.model.integrate import simulate
@@ -142,7 +143,8 @@ def test_the_first_screen_draws_a_held_out_run_with_the_measured_trace_on_top(
     found = Finding(cause="discovered", parameters={}, std={}, evidence="",
                     fit_before={"wheel_speed_rad_s": 90.0}, fit_after={"wheel_speed_rad_s": 95.0},
                     delta_bic=-50.0, held_out=-80.0, accepted=True, family="wheel",
-                    fitted_on=("stop_30bar",), checked_on=("stop_20bar (2.0-9.0 s)",))
+                    fitted_on=("stop_30bar",),
+                    checked_on=(part_name("stop_20bar", CUT_LATER),))
     result = Diagnosis(verdict="discovered", findings=[found], candidates=[], baseline={},
                        start=reference, calibrated=reference, extended=reference,
                        signatures_before=[], signatures_after=[],

@@ -47,6 +47,11 @@ def channel_words(channel: str) -> str:
     """A channel as pages, figures and reasons name it ('wheel speed'; its code name, the
     Run field, stays in the JSON)."""
     return CHANNELS.get(channel, channel).split(" [")[0]
+
+
+def channel_unit(channel: str) -> str:
+    """A contract channel's SI unit, as its label gives it ('Pa')."""
+    return CHANNELS[channel].split(" [")[1].rstrip("]")
 ACTUATOR_CHANNELS = ("pressure_pa",)
 """An actuator-only run carries information on the pressure alone."""
 LOWEST_SIM_SPEED_M_S = 1.0  # below this slip is ill-defined; the rig stops at 3 m/s

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from landing_gear_sim.calibration.measured import channel_words, channels_of
+from landing_gear_sim.calibration.measured import channel_unit, channel_words, channels_of
 from landing_gear_sim.calibration.noise import channel_noise
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.diagnosis.equations.registry import DECLARED
@@ -31,8 +31,6 @@ model of the shared nulls (2 kHz, 200 Hz, a noisy current, a 64-count encoder, a
 and of campaign_v2 reads at most 2.7 on any run and channel (the validation's pass is 3), an
 own null at 200 Hz through a noisy ADC 4.2 on one run of six."""
 ENVELOPE_S = 0.2  # the residual's running RMS: where it misses, not where a spike is
-SI_UNITS = {"pressure_pa": "Pa", "wheel_speed_rad_s": "rad/s", "flywheel_speed_rad_s": "rad/s",
-            "vertical_load_n": "N", "longitudinal_force_n": "N"}
 
 
 @dataclass(frozen=True)
@@ -104,7 +102,7 @@ def misfit_finding(found: Sequence[Misfit], baseline: dict[str, float]) -> Findi
     """The worst misfit as an ``unexplained`` finding in its channel's equation."""
     worst = found[0]
     runs = sorted({m.run for m in found if m.channel == worst.channel})
-    unit = SI_UNITS[worst.channel]
+    unit = channel_unit(worst.channel)
     evidence = (f"no candidate was accepted, yet the model misses the "
                 f"{channel_words(worst.channel)} by {worst.multiple:.1f} times its logger's "
                 f"noise on {worst.run} (RMSE {display(worst.rmse, unit, '.3g')}, noise "

@@ -181,10 +181,22 @@ def _held_out_in_time(fit: list[ClassifiedRun]
     if candidates.size == 0:
         return fit, []
     cut = int(candidates[np.argmin(np.abs(candidates - len(run) // 2))])
-    first, later = (ClassifiedRun.of(run.part(part, f"{run.name} ({which})"))
+    first, later = (ClassifiedRun.of(run.part(part, part_name(run.name, which)))
                     for part, which in ((slice(0, cut), CUT_FIRST), (slice(cut, None),
                                                                      CUT_LATER)))
     return [first if r is run else r for r in fit], [later]
+
+
+def part_name(run: str, which: str) -> str:
+    """The name of a part of ``run`` cut in time ('stop (first part)')."""
+    return f"{run} ({which})"
+
+
+def whole_run(name: str) -> str:
+    """The run a part cut in time was cut from (a whole run's name: itself)."""
+    for which in (CUT_FIRST, CUT_LATER):
+        name = name.removesuffix(f" ({which})")
+    return name
 
 
 @dataclass(frozen=True)
@@ -210,7 +222,7 @@ def score_candidate(candidate: Candidate, runs: Sequence[Run], model: RigParamet
     fit_runs, held_runs = split_runs(candidate, runs)
     scales = {**scales, **{(part.name, channel): value for part in (*fit_runs, *held_runs)
                            for (name, channel), value in scales.items()
-                           if part.name.startswith(f"{name} (")}}  # a run cut in time
+                           if whole_run(part.name) == name != part.name}}  # a run cut in time
     sub = _as_fitting(candidate, fit_runs)
     if candidate.settings:
         model = model.replace(dict(candidate.settings), f"{candidate.family}'s terms")

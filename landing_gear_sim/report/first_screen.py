@@ -13,6 +13,7 @@ import numpy as np
 
 from landing_gear_sim.calibration.measured import channel_words
 from landing_gear_sim.diagnosis.diagnose import Diagnosis
+from landing_gear_sim.diagnosis.scoring import whole_run
 from landing_gear_sim.diagnosis.signatures import RunEvidence
 from landing_gear_sim.report.figures import DISPLAY_UNITS, save_figure
 
@@ -49,7 +50,7 @@ def held_out_runs(result: Diagnosis) -> set[str]:
     """The runs the verdict's finding was checked on, not fitted on (a run cut in time,
     'stop (2.0-9.0 s)', as its whole run)."""
     best = result.findings[0] if result.findings else None
-    return {name.split(" (")[0] for name in best.checked_on} if best else set()
+    return {whole_run(name) for name in best.checked_on} if best else set()
 
 
 def worst_misfit(result: Diagnosis) -> Misfit | None:

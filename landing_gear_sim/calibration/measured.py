@@ -52,6 +52,8 @@ def channel_words(channel: str) -> str:
 def channel_unit(channel: str) -> str:
     """A contract channel's SI unit, as its label gives it ('Pa')."""
     return CHANNELS[channel].split(" [")[1].rstrip("]")
+
+
 ACTUATOR_CHANNELS = ("pressure_pa",)
 """An actuator-only run carries information on the pressure alone."""
 LOWEST_SIM_SPEED_M_S = 1.0  # below this slip is ill-defined; the rig stops at 3 m/s

@@ -128,7 +128,10 @@ def answer(campaign: Campaign) -> Answer:
     return {"verdict": result.verdict,
             "findings": [{"cause": f.cause, "family": f.family, "equation": f.equation,
                           "term": f.term, "parameters": dict(f.parameters),
-                          "uncertainty": dict(f.std)} for f in result.findings]}
+                          "uncertainty": dict(f.std)} for f in result.findings],
+            # what the campaign leaves open: said beside the verdict, not compared
+            "alike": [list(group.names) for group in result.alike],
+            "next_run": None if result.next_run is None else result.next_run.proposal.options}
 
 
 def differences(before: Answer, after: Answer) -> list[str]:
@@ -190,7 +193,8 @@ def main() -> int:
         now = done[campaign.key]
         shown = " ".join(f"{f['cause']}({f['family'] or f['equation']})"
                          for f in now["findings"])
-        line = f"{campaign.key:50s} {now['verdict']:12s} {shown}"
+        line = f"{campaign.key:50s} {now['verdict']:12s} {shown}" + "".join(
+            f" [{' or '.join(group)}]" for group in now.get("alike", []))
         if args.against:
             diff = differences(kept[campaign.key], now)
             found += bool(diff)

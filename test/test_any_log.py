@@ -3,6 +3,7 @@ datasheet naming what differs from the reference, one command to a verdict."""
 
 from __future__ import annotations
 
+import html
 import json
 import math
 
@@ -11,7 +12,7 @@ import pytest
 import yaml
 
 from antiskid.metrics import braking_metrics
-from landing_gear_sim.calibration.campaign import NOISE, generate_campaign, rig_like
+from landing_gear_sim.calibration.campaign import NOISE, generate_campaign, generate_run, rig_like
 from landing_gear_sim.calibration.identify import identify
 from landing_gear_sim.cli import main
 from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, diagnose
@@ -21,6 +22,8 @@ from landing_gear_sim.model import keys as K
 from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import load_parameters
+from landing_gear_sim.model.runspec import build_scenario
+from landing_gear_sim.report.diagnosis import diagnosis_summary, write_diagnosis_report
 from msg_tools.csv_io import read_csv, write_csv
 from msg_tools.errors import RunFormatError
 from msg_tools.io import read_campaign, read_run
@@ -202,16 +205,27 @@ def test_a_step_log_of_a_slow_valve_gives_its_delay_and_a_release_unlike_its_app
                if f.accepted and f.held_out is not None)
 
 
-def test_a_log_of_one_apply_and_one_release_says_what_one_more_step_would_settle(tmp_path):
+def test_a_log_of_one_apply_and_one_release_proposes_the_run_that_settles_it(tmp_path):
     """One apply and one release of that valve: the delay fitted on the apply cannot be
-    checked on a release unlike it; the verdict is inconclusive and says so."""
+    checked on a release unlike it; the verdict is inconclusive and says so. It proposes a
+    wheel-off run (the log has no wheel) that tells the delay from none; that run, made by
+    the same valve and logged as the first, settles it (issue 64, item 3)."""
     datasheet = _slow_datasheet(tmp_path)
-    rig, _ = _asymmetric_slow_valve(datasheet, 52)
-    result = diagnose(read_campaign(_step_log(rig, tmp_path / "logs", 1, 52)).runs,
-                      datasheet)
+    rig, delay = _asymmetric_slow_valve(datasheet, 52)
+    logs = _step_log(rig, tmp_path / "logs", 1, 52)
+    result = diagnose(read_campaign(logs).runs, datasheet)
     assert result.verdict == INCONCLUSIVE
     assert any("one more step" in p and "actuator_delay" in p for p in result.problems), \
         result.problems
+    proposed = result.next_run
+    assert proposed is not None and proposed.settles, proposed
+    assert "actuator_delay" in proposed.explanations and proposed.equation == "valve"
+    assert proposed.proposal.spec.profile in ("steps", "sweep", "ramp")
+    path = generate_run(tmp_path / "next", rig, build_scenario(proposed.proposal.spec, rig), 52)
+    _three_columns(path, logs / path.name)
+    settled = diagnose(read_campaign(logs).runs, datasheet)
+    assert settled.verdict == "actuator_delay", settled.verdict
+    assert settled.findings[0].parameters["delay_s"] == pytest.approx(delay, rel=0.05)
 
 
 def test_a_step_log_without_a_ramp_reads_the_valves_map_from_its_held_levels(tmp_path):
@@ -259,7 +273,7 @@ def test_what_reading_said_is_a_note_and_only_an_unread_file_is_skipped(tmp_path
     assert len(said) == 2
 
 
-def test_a_single_stop_says_what_one_more_run_would_settle(tmp_path):
+def test_a_single_stop_proposes_the_run_that_settles_it(tmp_path):
     """Issue 43, a campaign of one run: a braking run is one piece, never cut in time, so
     what it fits better cannot be checked; the note names the run one more like it would
     settle (it had said 'too little held-out data for a verdict')."""
@@ -272,6 +286,22 @@ def test_a_single_stop_says_what_one_more_run_would_settle(tmp_path):
     assert result.verdict == INCONCLUSIVE, result.verdict
     assert any("tire_relaxation" in p and "one more run like brake_const_30bar would settle"
                in p for p in result.problems), result.problems
+    # the run it proposes (a stop at constant pressure: what the relaxation is fitted on),
+    # made by the same rig, settles it (issue 64, item 3)
+    proposed = result.next_run
+    assert proposed is not None and proposed.settles, proposed
+    assert proposed.explanations == ("the model as calibrated", "tire_relaxation")
+    assert proposed.proposal.spec.profile == "constant" and proposed.equation == "tyre"
+    said = proposed.sentence()
+    assert result.to_json()["next_run"]["command"] in said  # type: ignore[index]
+    assert said[1:] in diagnosis_summary(result)  # its first letter a capital there
+    page = write_diagnosis_report(result, tmp_path / "report").read_text()
+    assert html.escape(said[1:]) in page.split("<details")[0]  # on the first screen
+    generate_run(tmp_path, rig, build_scenario(proposed.proposal.spec, rig), 57)
+    settled = diagnose(read_campaign(tmp_path).runs, load_parameters())
+    assert settled.verdict == "tire_relaxation", settled.verdict
+    assert settled.findings[0].parameters["relaxation_length_m"] == pytest.approx(
+        rig.number(K.TYRE_RELAXATION_LENGTH_M), rel=0.05)
 
 
 def _slow_valve_with_delay(datasheet, seed: int):

@@ -140,12 +140,35 @@ def generate_campaign(folder: Path, rig: RigParameters, seed: int = 0,
     order = _campaign_order([files[n] for n, s in scenarios.items() if s.contact])
     for name, scenario in scenarios.items():
         i = STANDARD_RUNS.index(name)  # a run's noise is its own, whichever others are made
-        params = _start_angle(_loaded(run_parameters(rig, order.get(files[name], 0.0)), name),
-                              np.random.default_rng([seed, i]))
-        result = simulate(params, scenario)
-        run = logger.write(result, result.to_run(noise=seed * 100 + i),
-                           np.random.default_rng([seed, i, 1]))
-        path = folder / f"{files[name]}.csv"
-        write_csv(run, path)
-        written.append(path)
+        params = _loaded(run_parameters(rig, order.get(files[name], 0.0)), name)
+        written.append(_write(folder / f"{files[name]}.csv", params, scenario, logger, seed, i))
     return written
+
+
+OWN_RUN = len(STANDARD_RUNS)
+"""The noise index of a run made alone (:func:`generate_run`): none of the standard runs'."""
+
+
+def generate_run(folder: Path, rig: RigParameters, scenario: sc.Scenario, seed: int = 0,
+                 logger: Logger | None = None) -> Path:
+    """One run of ``scenario`` as ``rig`` makes it (the run a diagnosis proposes to settle
+    what a campaign left open), logged as ``logger`` logs, written to
+    ``folder/<scenario name>.csv``; returns its path. Its noise is drawn from ``seed``, as
+    a campaign's runs are; the rig, like a campaign's middle run, has worn no further."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    logger = logger or Logger()
+    rig.to_yaml(folder / GENERATING_FILE)
+    return _write(folder / f"{scenario.name}.csv", rig, scenario, logger, seed, OWN_RUN)
+
+
+def _write(path: Path, params: RigParameters, scenario: sc.Scenario, logger: Logger,
+           seed: int, index: int) -> Path:
+    """The run of ``scenario`` under ``params`` (started at an angle of its own), logged
+    and written to ``path``; its noise drawn from ``seed`` and its ``index``."""
+    params = _start_angle(params, np.random.default_rng([seed, index]))
+    result = simulate(params, scenario)
+    run = logger.write(result, result.to_run(noise=seed * 100 + index),
+                       np.random.default_rng([seed, index, 1]))
+    write_csv(run, path)
+    return path

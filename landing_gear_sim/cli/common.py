@@ -95,9 +95,10 @@ def add_storage_argument(parser: argparse.ArgumentParser) -> None:
                         help="bag storage format (default mcap)")
 
 
-def add_run_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--profile", choices=[*PROFILES, "file"], default="constant",
-                        help="valve current profile (default: constant)")
+def add_run_arguments(parser: argparse.ArgumentParser,
+                      default: str | None = "constant") -> None:
+    parser.add_argument("--profile", choices=[*PROFILES, "file"], default=default,
+                        help=f"valve current profile (default: {default or 'none'})")
     parser.add_argument("--pressure-bar", type=float, default=30.0,
                         help="constant profile: target pressure (default 30 bar)")
     parser.add_argument("--current-a", type=float, help="constant profile: current instead")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -114,6 +115,9 @@ def _add_campaign(sub: argparse._SubParsersAction) -> None:
                      help="make the runs in an order drawn from the seed, named run01_... in "
                           "it (a brake that wears, with --set brake.gain_drift_per_run=-0.03, "
                           "wears in that order)")
+    one = gen.add_argument_group(
+        "one run instead of the standard set (what a diagnosis proposes to run next)")
+    add_run_arguments(one, default=None)
     gen.set_defaults(func=cmd_campaign)
 
 
@@ -296,18 +300,34 @@ def cmd_params(args: argparse.Namespace) -> int:
 def cmd_campaign(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from landing_gear_sim.calibration.campaign import GENERATING_FILE, generate_campaign, rig_like
+    from landing_gear_sim.calibration.campaign import (
+        GENERATING_FILE,
+        generate_campaign,
+        generate_run,
+        rig_like,
+    )
     from landing_gear_sim.calibration.logger import Logger
+    from landing_gear_sim.ros.graph import load_scenario
 
     if args.output.exists() and any(args.output.iterdir()):
         raise LandingGearSimError(f"{args.output}: exists and is not empty, not overwriting")
+    if args.profile is not None and (args.light_runs or args.shuffled):
+        raise LandingGearSimError("--profile writes one run: --light-runs and --shuffled are "
+                                  "for the standard set")
     logger = Logger.parse(args.logger)
     rig = rig_like(params_of(args), np.random.default_rng(args.seed), args.deviation)
     realities = "".join(f", {words}" for words in logger.realities)
-    progress(f"simulating a synthetic campaign (seed {args.seed}, datasheet "
-              f"±{100 * args.deviation:g} %{realities})")
-    for path in generate_campaign(args.output, rig, args.seed, light=args.light_runs,
-                                  logger=logger, shuffled=args.shuffled):
+    what = "a synthetic campaign" if args.profile is None else f"one {args.profile} run"
+    progress(f"simulating {what} (seed {args.seed}, datasheet ±{100 * args.deviation:g} %"
+             f"{realities})")
+    if args.profile is None:
+        paths = generate_campaign(args.output, rig, args.seed, light=args.light_runs,
+                                  logger=logger, shuffled=args.shuffled)
+    else:
+        spec = run_spec_of(args)
+        spec = replace(spec, rate_hz=logger.rate_hz or spec.rate_hz)
+        paths = [generate_run(args.output, rig, load_scenario(spec, rig), args.seed, logger)]
+    for path in paths:
         print(f"  {path}")
     print(f"generating parameters (for checks only): {args.output / GENERATING_FILE}")
     return 0

@@ -24,9 +24,10 @@ from landing_gear_sim.calibration import differences
 from landing_gear_sim.calibration.actuator import LATE
 from landing_gear_sim.calibration.identify import Identification, Progress, identify
 from landing_gear_sim.calibration.measured import CHANNELS, simulate_all
-from landing_gear_sim.calibration.runs import ClassifiedRun, classify_all, fully_logged
+from landing_gear_sim.calibration.runs import ClassifiedRun, Selector, classify_all, fully_logged
 from landing_gear_sim.calibration.statistics import Estimate
 from landing_gear_sim.diagnosis import discovered, rounds
+from landing_gear_sim.diagnosis.alike import Alike, name_of, rivals
 from landing_gear_sim.diagnosis.catalogue import (
     CATALOGUE,
     Candidate,
@@ -45,6 +46,7 @@ from landing_gear_sim.diagnosis.findings import Finding, Signature, approximatio
 from landing_gear_sim.diagnosis.identifiability import actuator_calibrated, untestable
 from landing_gear_sim.diagnosis.local import LocalGain, local_gains
 from landing_gear_sim.diagnosis.misfit import misfit_finding, misfits
+from landing_gear_sim.diagnosis.next_run import Explanation, NextRun, next_run
 from landing_gear_sim.diagnosis.relations import Check, structural
 from landing_gear_sim.diagnosis.rig_bounds import scaled_to_rig
 from landing_gear_sim.diagnosis.scoring import (
@@ -99,6 +101,11 @@ class Diagnosis:
     """k_b re-estimated per band and along each run, over the calibrated model's gain."""
     local_after: list[LocalGain] = field(default_factory=list)
     """The same over the extended model's gain."""
+    alike: list[Alike] = field(default_factory=list)
+    """Findings with the explanations the campaign cannot tell from them."""
+    next_run: NextRun | None = None
+    """The rig run that would settle what the campaign leaves open (its first group of alike
+    explanations, or what an ``inconclusive`` verdict could not test)."""
 
     def to_json(self) -> dict[str, object]:
         return {"verdict": self.verdict, "findings": [f.to_json() for f in self.findings],
@@ -111,9 +118,9 @@ class Diagnosis:
                 "local_gains": {"calibrated": [g.to_json() for g in self.local_before],
                                 "extended": [g.to_json() for g in self.local_after]},
                 "problems": self.problems,
+                "alike": [group.to_json() for group in self.alike],
+                "next_run": None if self.next_run is None else self.next_run.to_json(),
                 "datasheet": datasheet_values(self.start)}
-
-
 
 
 def candidates_for(start: RigParameters, without: Sequence[str]) -> list[Candidate]:
@@ -152,12 +159,15 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     start.problems.extend(coarse_channels(start.runs, calibrated_checks))
     story = discovered.Story(start.runs, start.calibrated, base, start.scales, start.tried,
                              calibrated_checks, say)
-    model, accepted, checks = _extended(story, search, checks)
+    model, accepted, checks, discovered_rivals = _extended(story, search, checks)
     say("analysing the residuals of the extended model")
     simulated_after = simulate_all(start.runs, model)
     after = _interpretable(find_signatures(start.runs, model, simulated_after), start.runs)
     verdict, findings = _verdict(start, search.table, accepted, model, checks,
                                  simulated_after, after)
+    groups = _alike(search, accepted, discovered_rivals, start.runs, say)
+    settling = groups[0].next_run if groups else (
+        _settling(start, search, say) if verdict == INCONCLUSIVE else None)
     start.problems.extend(under_floor(checks))
     problems = _answered(start.problems, search.table)
     evidence = [run_evidence(*sims, start.calibrated) for sims in
@@ -165,7 +175,8 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     return Diagnosis(verdict, findings, search.table, start.baseline, start.start,
                      start.calibrated, model, start.before, after, problems, evidence, checks,
                      calibrated_checks, start.calibration.estimates,
-                     local_gains(start.runs, start.calibrated), local_gains(start.runs, model))
+                     local_gains(start.runs, start.calibrated), local_gains(start.runs, model),
+                     groups, settling)
 
 
 DERIVATIVES_NOTE_AFTER_S = 2.0  # loading them from numba's cache takes a fraction of that
@@ -238,24 +249,67 @@ def _calibrated_start(runs: Sequence[Run], base: RigParameters, without: Sequenc
                   pending, skipped, problems)
 
 
-
-
-
-
 def _extended(story: discovered.Story, search: rounds.Search, checks: list[Check]
-              ) -> tuple[RigParameters, list[Scored], list[Check]]:
+              ) -> tuple[RigParameters, list[Scored], list[Check], tuple[Scored, ...]]:
     """The model extended by a discovered term where the equations call for one (the
-    search's own otherwise), its accepted causes and its relations' checks."""
+    search's own otherwise), its accepted causes, its relations' checks, and the terms the
+    campaign cannot tell from the discovered one."""
     model, accepted = search.model, search.accepted
     found = story.extend(accepted, model, checks)
     if found is None:
-        return model, accepted, checks
+        return model, accepted, checks, ()
     search.table.extend(found.tried)
     if found.scored is None:
-        return model, accepted, checks
+        return model, accepted, checks, ()
     model = found.scored.fit.params
     accepted = [*(rounds.refreshed(s, model) for s in found.kept), found.scored]
-    return model, accepted, search.consistency.of(model)
+    return model, accepted, search.consistency.of(model), found.rivals
+
+
+def _alike(search: rounds.Search, accepted: list[Scored], discovered_rivals: Sequence[Scored],
+           runs: Sequence[ClassifiedRun], say: Progress) -> list[Alike]:
+    """Each accepted cause with the candidates of its round the campaign cannot tell from
+    it, and the run that would: the catalogue's rounds' then the discovered term's."""
+    final = [name_of(s.finding) for s in accepted]
+    leaders = {name_of(s.finding): s.finding for s in accepted}
+    pairs = [(r.best, found) for r in search.rounds
+             if r.best is not None and name_of(r.best.finding) in leaders
+             and (found := rivals(r.best, r.scored, final))]
+    if discovered_rivals:
+        pairs.append((accepted[-1], list(discovered_rivals)))
+    groups = []
+    for best, others in pairs:
+        names = [name_of(s.finding) for s in (best, *others)]
+        say(f"{' or '.join(names)}: the campaign cannot tell them apart; simulating the runs "
+            "that would")
+        explanations = [Explanation(name, s.fit.params, _kinds(s))
+                        for name, s in zip(names, (best, *others), strict=True)]
+        groups.append(Alike((leaders[names[0]], *(s.finding for s in others)),
+                            next_run(explanations, runs)))
+    return groups
+
+
+def _kinds(scored: Scored) -> tuple[Selector, ...]:
+    """The run kinds a scored candidate reads: fitted on, and checked on (a catalogued
+    one's own: its fit's are the setups of the runs it was fitted on)."""
+    candidate = CATALOGUE.get(scored.finding.cause, scored.fit.candidate)
+    return (*candidate.runs, *candidate.held_out)
+
+
+def _settling(start: _Start, search: rounds.Search, say: Progress) -> NextRun | None:
+    """The run that would settle an ``inconclusive`` verdict: the model as calibrated
+    against every candidate that fitted better but could not be confirmed, as fitted. One
+    the runs could not test has no size to simulate it at: the notes name the run it
+    needs."""
+    fitted = {s.finding.cause: s for r in search.rounds for s in r.scored}  # its last round
+    open_ = {f.cause: fitted[f.cause] for f in search.table if f.cause in fitted
+             and not f.accepted and f.delta_bic is not None and f.delta_bic < BIC_THRESHOLD}
+    explanations = [Explanation("the model as calibrated", start.calibrated),
+                    *(Explanation(cause, s.fit.params, _kinds(s)) for cause, s in open_.items())]
+    if len(explanations) < 2:
+        return None
+    say("simulating the runs that would settle it")
+    return next_run(explanations, start.runs)
 
 
 def _verdict(start: _Start, table: list[Finding], accepted: list[Scored],
@@ -311,10 +365,6 @@ def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],
     return testable, [c for c in skipped if _could_show(CATALOGUE[c], runs)]
 
 
-
-
-
-
 def _could_show(candidate: Candidate, runs: Sequence[ClassifiedRun]) -> bool:
     """Whether an untested ``candidate`` could be what the runs show: not one seen only in
     braking runs' channels when no run brakes (an actuator-only log's verdict is the
@@ -353,14 +403,6 @@ def _unsettled_in_time(table: Sequence[Finding]) -> list[str]:
             if not f.accepted and f.delta_bic is not None and f.delta_bic < BIC_THRESHOLD
             and f.held_out is not None and f.held_out >= HELD_OUT_THRESHOLD and f.checked_on
             and all(name.endswith(f" ({CUT_LATER})") for name in f.checked_on)]
-
-
-
-
-
-
-
-
 
 
 def baseline_fits(runs: Sequence[ClassifiedRun], simulated: Sequence[Run]

@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 from landing_gear_sim.calibration.identify import Progress
 from landing_gear_sim.calibration.measured import CHANNELS, channels_of, simulate_all
 from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.diagnosis.alike import rivals
 from landing_gear_sim.diagnosis.consistency import check_campaign
 from landing_gear_sim.diagnosis.families import REGISTRY, Evidence, Family, Proposal
 from landing_gear_sim.diagnosis.families.wheel_skew import wheel_lags
@@ -38,10 +39,27 @@ PREDICTS_BETTER = 2.0  # a held-out gain this many times another's outweighs its
 
 
 def discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: RigParameters,
-              scales: Scales, signatures: Sequence[Signature], checks: Sequence[Check],
-              say: Progress) -> Scored | None:
+             scales: Scales, signatures: Sequence[Signature], checks: Sequence[Check],
+             say: Progress) -> Scored | None:
+    """:func:`discovered`'s term alone."""
+    return discovered(runs, model, datasheet, scales, signatures, checks, say).scored
+
+
+@dataclass(frozen=True)
+class Discovery:
+    """The discovered term (None: no family called for) and the accepted terms the
+    campaign cannot tell from it (:mod:`~landing_gear_sim.diagnosis.alike`)."""
+
+    scored: Scored | None
+    rivals: tuple[Scored, ...] = ()
+
+
+def discovered(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: RigParameters,
+               scales: Scales, signatures: Sequence[Signature], checks: Sequence[Check],
+               say: Progress) -> Discovery:
     """A discovered term, scored, for what ``checks`` and ``signatures`` (of ``model``)
-    show, or None when no family is called for: the families of REGISTRY by rank, until
+    show (None when no family is called for), with the terms the campaign cannot tell from
+    it: the families of REGISTRY by rank, until
     one rank accepts a term that leaves no later family's relation violated (the better is
     kept: :func:`_better`). A wheel bearing's torque once read as a brake gain falling with
     the pressure (rank 6, held out −45) and left free rolling violated; its own equation's
@@ -49,6 +67,7 @@ def discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: Rig
     evidence = Evidence(runs, model, checks, signatures)
     violated = _Violated(runs)
     best: tuple[Family, Scored] | None = None
+    accepted: list[Scored] = []
     for _, members in itertools.groupby(REGISTRY, key=lambda f: f.rank):
         group = list(members)
         if best is not None and best[1].finding.accepted:
@@ -58,10 +77,25 @@ def discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: Rig
             for proposal in family.propose(evidence):
                 scored = _score_discovered(family, proposal, runs, model, datasheet, scales,
                                            signatures, say)
+                if scored is not None and scored.finding.accepted:
+                    accepted.append(scored)
                 if scored is not None and (best is None or _better(best[1], scored, violated)
                                            is scored):
                     best = (family, scored)
-    return None if best is None else _called_for(*best, evidence)
+    if best is None:
+        return Discovery(None)
+    return Discovery(_called_for(*best, evidence), _rivals(best[1], accepted, violated))
+
+
+def _rivals(best: Scored, accepted: Sequence[Scored],
+            violated: Callable[[Scored], list[Check]]) -> tuple[Scored, ...]:
+    """The accepted terms the campaign cannot tell from ``best``: gains alike, measured
+    alike (:func:`_alike`), and as many relations left violated (fewer would have told
+    them apart)."""
+    if not best.finding.accepted:
+        return ()
+    return tuple(s for s in rivals(best, accepted)
+                 if _alike(best, s) and len(violated(s)) == len(violated(best)))
 
 
 def _called_for(family: Family, scored: Scored, evidence: Evidence) -> Scored:
@@ -130,11 +164,13 @@ class _Violated:
 @dataclass(frozen=True)
 class Extension:
     """What the story's extension scored (``tried``, for the table), the catalogued causes
-    it keeps, and the discovered term it accepted (None: none)."""
+    it keeps, the discovered term it accepted (None: none) and the terms the campaign
+    cannot tell from that one."""
 
     tried: list[Finding]
     kept: list[Scored]
     scored: Scored | None
+    rivals: tuple[Scored, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -161,47 +197,54 @@ class Story:
         channels. Otherwise the term is sought beside the causes, from their model. Nothing
         is sought when the causes leave no relation violated and no lag."""
         if not accepted:
-            found = self._discover(self.calibrated, self.checks, self.signatures)
-            return None if found is None else Extension(
-                [found.finding], [], found if found.finding.accepted else None)
+            alone = self._discover(self.calibrated, self.checks, self.signatures)
+            term = alone.scored
+            return None if term is None else Extension(
+                [term.finding], [], term if term.finding.accepted else None, alone.rivals)
         signatures = find_signatures(self.runs, model, simulate_all(self.runs, model),
                                      tentative=True)
         if not violations(checks) and not wheel_lags(signatures):
             return None
         tried = []
-        rival = self._discover(self.calibrated, self.checks, self.signatures)
+        alone = self._discover(self.calibrated, self.checks, self.signatures)
+        rival = alone.scored
         if rival is not None:
             tried.append(rival.finding)
             if explains_more(rival, accepted, model, self.runs, self.scales):
                 self.say(f"a discovered term explains more than {_causes(accepted)}: "
                          f"{rival.finding.term}")
-                return Extension(tried, [], rival)
-        beside = self._discover(model, checks, signatures)
+                return Extension(tried, [], rival, alone.rivals)
+        found = self._discover(model, checks, signatures)
+        beside = found.scored
         if beside is not None:
             tried.append(beside.finding)
             if beside.finding.accepted:
-                return self._beside(tried, accepted, beside, rival)
+                return self._beside(tried, accepted, found, alone)
         return Extension(tried, accepted, None)
 
-    def _beside(self, tried: list[Finding], accepted: list[Scored], beside: Scored,
-                rival: Scored | None) -> Extension:
+    def _beside(self, tried: list[Finding], accepted: list[Scored], found: Discovery,
+                alone: Discovery) -> Extension:
         """The discovered term ``beside`` the causes that still earn their place beside it:
         each cause with an element is scored again from the extended model with its element
         off. A tyre's relaxation once fitted what a loading device's law, wrong in speed,
         left in the wheel channels (held out −2072 from the calibrated model); beside the
-        law it is not needed. When no cause is left, the term fitted alone (``rival``)."""
+        law it is not needed. When no cause is left, the term fitted alone (``alone``)."""
+        beside, rival = found.scored, alone.scored
+        if beside is None:
+            return Extension(tried, accepted, None)
         earns = [self._earns(s, beside.fit.params) for s in accepted]
         if all(earns):
-            return Extension(tried, accepted, beside)
+            return Extension(tried, accepted, beside, found.rivals)
         kept = [s for s, e in zip(accepted, earns, strict=True) if e]
         dropped = [s for s, e in zip(accepted, earns, strict=True) if not e]
         self.say(f"{_causes(dropped)} not needed beside {beside.finding.term}")
         if not kept and rival is not None and rival.finding.accepted:
-            return Extension(tried, [], rival)
+            return Extension(tried, [], rival, alone.rivals)
         params = beside.fit.params.replace(
             {f"elements.{s.fit.candidate.element}": False for s in dropped},
             "causes not needed beside the discovered term")
-        return Extension(tried, kept, Scored(beside.finding, replace(beside.fit, params=params)))
+        return Extension(tried, kept, Scored(beside.finding, replace(beside.fit, params=params)),
+                         found.rivals)
 
     def _earns(self, cause: Scored, extended: RigParameters) -> bool:
         """Whether ``cause`` is still accepted when scored from ``extended`` without it."""
@@ -218,8 +261,8 @@ class Story:
         return again.finding.accepted
 
     def _discover(self, model: RigParameters, checks: Sequence[Check],
-                  signatures: Sequence[Signature]) -> Scored | None:
-        return discover(self.runs, model, self.datasheet, self.scales, signatures, checks,
+                  signatures: Sequence[Signature]) -> Discovery:
+        return discovered(self.runs, model, self.datasheet, self.scales, signatures, checks,
                         self.say)
 
 

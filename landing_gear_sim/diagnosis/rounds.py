@@ -13,7 +13,7 @@ import multiprocessing
 import os
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 from landing_gear_sim.calibration.identify import Progress, identify
 from landing_gear_sim.calibration.runs import ClassifiedRun
@@ -41,15 +41,26 @@ from landing_gear_sim.processes import busy_counter, pool_worker, working
 MAX_ROUNDS = 4
 
 
+@dataclass(frozen=True)
+class Round:
+    """One round of the search: every candidate it scored, and the one it adopted (None:
+    none was accepted)."""
+
+    scored: list[Scored]
+    best: Scored | None
+
+
 @dataclass
 class Search:
     """What the catalogue's rounds end with: the model with the accepted causes, those
-    causes, every candidate scored (by round), and the relations' checks of each model."""
+    causes, every candidate scored (by round, for the table and as fitted), and the
+    relations' checks of each model."""
 
     model: RigParameters
     accepted: list[Scored]
     table: list[Finding]
     consistency: Consistency
+    rounds: list[Round] = field(default_factory=list)
 
 
 class Consistency:
@@ -102,6 +113,7 @@ def search(runs: Sequence[ClassifiedRun], start: RigParameters, without: Sequenc
         best = min(winners, key=lambda s: s.finding.delta_bic or 0.0) if winners else None
         found.table.extend(replace(s.finding, round=round_, reason=_round_reason(s, best))
                            for s in scored)
+        found.rounds.append(Round(scored, best))
         if best is None:
             break
         say(f"accepted {best.finding.cause}: {best.finding.evidence}")

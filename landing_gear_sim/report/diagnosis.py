@@ -35,6 +35,7 @@ from landing_gear_sim.report.words import (
     fits_words,
     headline,
     held_out_words,
+    open_sentence,
     parameters_text,
     title_words,
     verdict_text,
@@ -151,7 +152,9 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
           _text(_gain(f.held_out)), ", ".join(f.fitted_on), ", ".join(f.checked_on)]
          for f in result.candidates])
     figure = first_figure(result, folder)
+    left_open = open_sentence(result)
     verdict = (f"<p><b>{html.escape(headline(result))}</b></p>"
+               + (f"<p><b>{html.escape(left_open)}</b></p>" if left_open else "")
                + (html_image(figure, folder) if figure else "") + "<p>Starting model: "
                f"{', '.join(result.start.sources)}{html.escape(_datasheet(result.start))}. "
                "ΔBIC = BIC(with) − BIC(without) on the "
@@ -349,6 +352,8 @@ def diagnosis_summary(result: Diagnosis) -> str:
     lines.append(f"baseline fit %: {_fits(result.baseline)}")
     lines.append(f"VERDICT: {verdict_text(result)}")
     lines.append(f"  {headline(result)}")
+    if left_open := open_sentence(result):
+        lines.append(f"  {left_open}")
     if result.verdict == INCONCLUSIVE:
         lines.append("  the runs given cannot test every candidate, or none is left to check one "
                      "on: see the notes")

@@ -8,6 +8,7 @@ import re
 from collections.abc import Sequence
 
 from landing_gear_sim.calibration.measured import channel_words
+from landing_gear_sim.diagnosis.alike import Alike, name_of
 from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
 from landing_gear_sim.diagnosis.families import REGISTRY
 from landing_gear_sim.diagnosis.findings import Finding
@@ -160,6 +161,28 @@ def headline(result: Diagnosis) -> str:
     also = "; ".join(finding_sentence(f, f.cause, gain=False) for f in others)  # both at once
     return (finding_sentence(best, verdict_text(result)) + "."
             + (f" Also {also}." if also else ""))
+
+
+def alike_sentence(group: Alike) -> str:
+    """A group of alike explanations: each with its law or values and its held-out gain
+    (its ΔBIC and held-out log-likelihood gain beside), that the campaign cannot tell them
+    apart, and the run that would."""
+    each = " or ".join(
+        finding_sentence(f, name_of(f)) + f" (evidence {evidence_class(f.delta_bic)}, "
+        f"held-out gain {-(f.held_out or 0.0):+.1f})" for f in group.members)
+    settle = f"; {group.next_run.sentence()}" if group.next_run is not None else ""
+    return f"{each}: this campaign cannot tell them apart{settle}."
+
+
+def open_sentence(result: Diagnosis) -> str:
+    """What the campaign leaves open, in words ('' when nothing): each group of alike
+    explanations, or the run that would settle an ``inconclusive`` verdict."""
+    if result.alike:
+        return " ".join(alike_sentence(g) for g in result.alike)
+    if result.next_run is not None:
+        settle = result.next_run.sentence()
+        return f"{settle[0].upper()}{settle[1:]}."
+    return ""
 
 
 def verdict_text(result: Diagnosis) -> str:

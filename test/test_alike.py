@@ -1,0 +1,70 @@
+"""Alike explanations are named together (issue 64, item 2): two candidates that both meet
+the evidence, neither explaining the campaign twice as well as the other, by ΔBIC or held
+out, cannot be told apart by it; one accepted later in its own right is another cause. The
+rule on findings, in milliseconds."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from landing_gear_sim.diagnosis.alike import ALIKE_FACTOR, cannot_tell_apart, rivals
+from landing_gear_sim.diagnosis.findings import Finding
+from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, HELD_OUT_THRESHOLD
+
+
+def _finding(cause: str, delta_bic: float | None, held_out: float | None,
+             family: str = "") -> Finding:
+    return Finding(cause=cause, parameters={}, std={}, evidence="", fit_before={},
+                   fit_after={}, delta_bic=delta_bic, held_out=held_out, accepted=True,
+                   family=family)
+
+
+def _scored(finding: Finding) -> SimpleNamespace:
+    return SimpleNamespace(finding=finding)
+
+
+@pytest.fixture
+def gains() -> tuple[float, float]:
+    """A ΔBIC and a held-out gain that meet the evidence, drawn."""
+    rng = np.random.default_rng(64)
+    return float(rng.uniform(-5000.0, -50.0)), float(rng.uniform(-3000.0, -30.0))
+
+
+def test_two_candidates_within_a_factor_of_two_on_both_counts_cannot_be_told_apart(gains):
+    bic, held = gains
+    first = _finding("actuator_delay", bic, held)
+    second = _finding("discovered", 0.8 * bic, 1.5 * held, family="pressure_skew")
+    assert cannot_tell_apart(first, second) and cannot_tell_apart(second, first)
+
+
+@pytest.mark.parametrize("which", ["delta_bic", "held_out"])
+def test_one_that_explains_twice_as_much_on_either_count_is_told_apart(gains, which):
+    bic, held = gains
+    first = _finding("actuator_delay", bic, held)
+    more = {"delta_bic": bic, "held_out": held}
+    more[which] *= 1.05 * ALIKE_FACTOR
+    second = _finding("actuator_dynamics", more["delta_bic"], more["held_out"])
+    assert not cannot_tell_apart(first, second)
+
+
+def test_a_candidate_short_of_the_evidence_is_no_rival(gains):
+    bic, held = gains
+    first = _finding("actuator_delay", bic, held)
+    for short in (_finding("drag", 0.9 * BIC_THRESHOLD, held),
+                  _finding("drag", bic, 0.9 * HELD_OUT_THRESHOLD),
+                  _finding("drag", bic, None)):
+        assert not cannot_tell_apart(first, short), short
+
+
+def test_a_rival_accepted_later_in_its_own_right_is_another_cause_not_a_rival(gains):
+    bic, held = gains
+    best = _scored(_finding("actuator_delay", bic, held))
+    offset = _scored(_finding("pressure_sensor_offset", 0.9 * bic, 0.9 * held))
+    dynamics = _scored(_finding("actuator_dynamics", 0.7 * bic, 0.8 * held))
+    far = _scored(_finding("drag", 0.1 * bic, 0.1 * held))
+    found = rivals(best, [best, offset, dynamics, far],  # type: ignore[list-item]
+                   accepted_later=["pressure_sensor_offset"])
+    assert found == [dynamics]

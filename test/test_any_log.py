@@ -290,7 +290,8 @@ def test_a_single_stop_proposes_the_run_that_settles_it(tmp_path):
     # made by the same rig, settles it (issue 64, item 3)
     proposed = result.next_run
     assert proposed is not None and proposed.settles, proposed
-    assert proposed.explanations == ("the model as calibrated", "tire_relaxation")
+    assert proposed.explanations[0] == "the model as calibrated"
+    assert "tire_relaxation" in proposed.explanations
     assert proposed.proposal.spec.profile == "constant" and proposed.equation == "tyre"
     said = proposed.sentence()
     assert result.to_json()["next_run"]["command"] in said  # type: ignore[index]

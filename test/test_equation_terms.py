@@ -182,7 +182,9 @@ def test_a_later_family_is_tried_when_the_accepted_term_leaves_its_relation_viol
 
     law, bearing = Stand("law", 6, Relation.GAIN_IN_PRESSURE), Stand("wheel", 8,
                                                                      Relation.FREE_ROLLING)
-    accepted = type("Accepted", (), {"finding": type("F", (), {"accepted": True})()})
+    accepted = type("Accepted", (), {"finding": type("F", (), {
+        "accepted": True, "cause": "discovered", "family": "", "delta_bic": None,
+        "held_out": None})()})
     scored = {"law": accepted(), "wheel": accepted()}
     monkeypatch.setattr(d, "REGISTRY", (law, bearing))
     monkeypatch.setattr(d, "_score_discovered", lambda family, *_: scored[family.name])
@@ -276,7 +278,7 @@ def test_of_two_causes_beside_a_discovered_term_only_the_one_it_replaces_goes(re
     in); the one that no longer earns its place goes, its element off in the final model,
     and the other stays."""
     from landing_gear_sim.diagnosis.catalogue import CATALOGUE, CandidateFit
-    from landing_gear_sim.diagnosis.discovered import Story
+    from landing_gear_sim.diagnosis.discovered import Discovery, Story
     from landing_gear_sim.diagnosis.findings import Finding
     from landing_gear_sim.diagnosis.scoring import Scored
 
@@ -295,7 +297,8 @@ def test_of_two_causes_beside_a_discovered_term_only_the_one_it_replaces_goes(re
     said: list[str] = []
     story = Story([], reference, reference, {}, [], [], said.append)
     monkeypatch.setattr(Story, "_earns", lambda self, cause, model: cause is causes[1])
-    extension = story._beside([], causes, scored("discovered", extended), None)
+    extension = story._beside([], causes, Discovery(scored("discovered", extended)),
+                              Discovery(None))
     assert extension.kept == [causes[1]] and said == [
         "tire_relaxation not needed beside law of discovered"]
     final = extension.scored.fit.params

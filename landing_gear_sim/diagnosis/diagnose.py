@@ -159,15 +159,16 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     start.problems.extend(coarse_channels(start.runs, calibrated_checks))
     story = discovered.Story(start.runs, start.calibrated, base, start.scales, start.tried,
                              calibrated_checks, say)
-    model, accepted, checks, discovered_rivals = _extended(story, search, checks)
+    model, accepted, checks, extension = _extended(story, search, checks)
     say("analysing the residuals of the extended model")
     simulated_after = simulate_all(start.runs, model)
     after = _interpretable(find_signatures(start.runs, model, simulated_after), start.runs)
     verdict, findings = _verdict(start, search.table, accepted, model, checks,
                                  simulated_after, after)
-    groups = _alike(search, accepted, discovered_rivals, start.runs, say)
+    groups = _alike(search, accepted, extension.rivals if extension else (), start.runs, say)
     settling = groups[0].next_run if groups else (
-        _settling(start, search, say) if verdict == INCONCLUSIVE else None)
+        _settling(start, search, extension.tried if extension else [], say)
+        if verdict == INCONCLUSIVE else None)
     start.problems.extend(under_floor(checks))
     problems = _answered(start.problems, search.table)
     evidence = [run_evidence(*sims, start.calibrated) for sims in
@@ -250,20 +251,20 @@ def _calibrated_start(runs: Sequence[Run], base: RigParameters, without: Sequenc
 
 
 def _extended(story: discovered.Story, search: rounds.Search, checks: list[Check]
-              ) -> tuple[RigParameters, list[Scored], list[Check], tuple[Scored, ...]]:
+              ) -> tuple[RigParameters, list[Scored], list[Check], discovered.Extension | None]:
     """The model extended by a discovered term where the equations call for one (the
-    search's own otherwise), its accepted causes, its relations' checks, and the terms the
-    campaign cannot tell from the discovered one."""
+    search's own otherwise), its accepted causes, its relations' checks, and the extension
+    (None: no term was called for)."""
     model, accepted = search.model, search.accepted
     found = story.extend(accepted, model, checks)
     if found is None:
-        return model, accepted, checks, ()
-    search.table.extend(found.tried)
+        return model, accepted, checks, None
+    search.table.extend(s.finding for s in found.tried)
     if found.scored is None:
-        return model, accepted, checks, ()
+        return model, accepted, checks, found
     model = found.scored.fit.params
     accepted = [*(rounds.refreshed(s, model) for s in found.kept), found.scored]
-    return model, accepted, search.consistency.of(model), found.rivals
+    return model, accepted, search.consistency.of(model), found
 
 
 def _alike(search: rounds.Search, accepted: list[Scored], discovered_rivals: Sequence[Scored],
@@ -296,16 +297,18 @@ def _kinds(scored: Scored) -> tuple[Selector, ...]:
     return (*candidate.runs, *candidate.held_out)
 
 
-def _settling(start: _Start, search: rounds.Search, say: Progress) -> NextRun | None:
+def _settling(start: _Start, search: rounds.Search, terms: Sequence[Scored], say: Progress
+              ) -> NextRun | None:
     """The run that would settle an ``inconclusive`` verdict: the model as calibrated
-    against every candidate that fitted better but could not be confirmed, as fitted. One
-    the runs could not test has no size to simulate it at: the notes name the run it
-    needs."""
-    fitted = {s.finding.cause: s for r in search.rounds for s in r.scored}  # its last round
-    open_ = {f.cause: fitted[f.cause] for f in search.table if f.cause in fitted
-             and not f.accepted and f.delta_bic is not None and f.delta_bic < BIC_THRESHOLD}
+    against every candidate (catalogued, or a discovered term of ``terms``) that fitted
+    better but could not be confirmed, as fitted. One the runs could not test has no size
+    to simulate it at: the notes name the run it needs."""
+    fitted = {name_of(s.finding): s for r in search.rounds for s in r.scored}  # its last round
+    fitted |= {name_of(s.finding): s for s in terms}
+    open_ = {name: s for name, s in fitted.items() if not s.finding.accepted
+             and s.finding.delta_bic is not None and s.finding.delta_bic < BIC_THRESHOLD}
     explanations = [Explanation("the model as calibrated", start.calibrated),
-                    *(Explanation(cause, s.fit.params, _kinds(s)) for cause, s in open_.items())]
+                    *(Explanation(name, s.fit.params, _kinds(s)) for name, s in open_.items())]
     if len(explanations) < 2:
         return None
     say("simulating the runs that would settle it")

@@ -22,7 +22,7 @@ from landing_gear_sim.diagnosis.alike import rivals
 from landing_gear_sim.diagnosis.consistency import check_campaign
 from landing_gear_sim.diagnosis.families import REGISTRY, Evidence, Family, Proposal
 from landing_gear_sim.diagnosis.families.wheel_skew import wheel_lags
-from landing_gear_sim.diagnosis.findings import Finding, Signature
+from landing_gear_sim.diagnosis.findings import Signature
 from landing_gear_sim.diagnosis.objective import Scales, scaled_error
 from landing_gear_sim.diagnosis.relations import Check, violations
 from landing_gear_sim.diagnosis.scoring import (
@@ -163,11 +163,11 @@ class _Violated:
 
 @dataclass(frozen=True)
 class Extension:
-    """What the story's extension scored (``tried``, for the table), the catalogued causes
-    it keeps, the discovered term it accepted (None: none) and the terms the campaign
-    cannot tell from that one."""
+    """What the story's extension scored (``tried``: the table's, and what an
+    ``inconclusive`` verdict leaves open), the catalogued causes it keeps, the discovered
+    term it accepted (None: none) and the terms the campaign cannot tell from that one."""
 
-    tried: list[Finding]
+    tried: list[Scored]
     kept: list[Scored]
     scored: Scored | None
     rivals: tuple[Scored, ...] = ()
@@ -200,7 +200,7 @@ class Story:
             alone = self._discover(self.calibrated, self.checks, self.signatures)
             term = alone.scored
             return None if term is None else Extension(
-                [term.finding], [], term if term.finding.accepted else None, alone.rivals)
+                [term], [], term if term.finding.accepted else None, alone.rivals)
         signatures = find_signatures(self.runs, model, simulate_all(self.runs, model),
                                      tentative=True)
         if not violations(checks) and not wheel_lags(signatures):
@@ -209,7 +209,7 @@ class Story:
         alone = self._discover(self.calibrated, self.checks, self.signatures)
         rival = alone.scored
         if rival is not None:
-            tried.append(rival.finding)
+            tried.append(rival)
             if explains_more(rival, accepted, model, self.runs, self.scales):
                 self.say(f"a discovered term explains more than {_causes(accepted)}: "
                          f"{rival.finding.term}")
@@ -217,12 +217,12 @@ class Story:
         found = self._discover(model, checks, signatures)
         beside = found.scored
         if beside is not None:
-            tried.append(beside.finding)
+            tried.append(beside)
             if beside.finding.accepted:
                 return self._beside(tried, accepted, found, alone)
         return Extension(tried, accepted, None)
 
-    def _beside(self, tried: list[Finding], accepted: list[Scored], found: Discovery,
+    def _beside(self, tried: list[Scored], accepted: list[Scored], found: Discovery,
                 alone: Discovery) -> Extension:
         """The discovered term ``beside`` the causes that still earn their place beside it:
         each cause with an element is scored again from the extended model with its element

@@ -12,8 +12,12 @@ import pytest
 
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.calibration.runs import classify_all
-from landing_gear_sim.diagnosis import diagnose as dg
-from landing_gear_sim.diagnosis.alike import ALIKE_FACTOR, cannot_tell_apart, rivals
+from landing_gear_sim.diagnosis.alike import (
+    ALIKE_FACTOR,
+    alike_groups,
+    cannot_tell_apart,
+    rivals,
+)
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.rounds import Round
 from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, HELD_OUT_THRESHOLD, Scored
@@ -94,11 +98,11 @@ def test_a_rounds_rival_stands_beside_the_verdict_with_the_run_that_tells_them_a
         return Scored(finding, fit)  # type: ignore[arg-type]
     best = scored(delay, {"elements.actuator_delay": True, K.ACTUATOR_DELAY_S: late_s})
     rival = scored(late, {K.SENSORS_PRESSURE_DELAY_S: late_s})
-    search = SimpleNamespace(rounds=[Round([best, rival, scored(short, {})], best)])
+    rounds = [Round([best, rival, scored(short, {})], best)]
     generate_campaign(tmp_path, rig_like(reference, np.random.default_rng(66)), 66,
                       ["actuator_steps_sweep", "brake_const_30bar"])
     runs = classify_all(read_campaign(tmp_path).runs)
-    [group] = dg._alike(search, [best], (), runs, lambda _: None)  # type: ignore[arg-type]
+    [group] = alike_groups(rounds, [best], (), runs, lambda _: None)
     assert group.names == ("actuator_delay", "discovered channel_skew")
     assert group.members[0] is delay and group.next_run is not None
     assert group.next_run.settles and group.next_run.closest.channel != "pressure_pa"

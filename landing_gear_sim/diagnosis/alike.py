@@ -16,11 +16,14 @@ A rival accepted later in its own right is another cause, not a rival.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
+from landing_gear_sim.calibration.runs import ClassifiedRun
+from landing_gear_sim.diagnosis.catalogue import CATALOGUE
 from landing_gear_sim.diagnosis.findings import Finding
-from landing_gear_sim.diagnosis.next_run import NextRun
+from landing_gear_sim.diagnosis.next_run import Explanation, NextRun, next_run
+from landing_gear_sim.diagnosis.rounds import Round
 from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, HELD_OUT_THRESHOLD, Scored
 
 ALIKE_FACTOR = 2.0
@@ -77,3 +80,36 @@ def rivals(best: Scored, scored: Sequence[Scored], accepted_later: Sequence[str]
     return [s for s in scored if s is not best
             and name_of(s.finding) not in (name_of(best.finding), *accepted_later)
             and cannot_tell_apart(best.finding, s.finding)]
+
+
+def alike_groups(rounds: Sequence[Round], accepted: Sequence[Scored],
+                 discovered_rivals: Sequence[Scored], runs: Sequence[ClassifiedRun],
+                 say: Callable[[str], None]) -> list[Alike]:
+    """Each accepted cause (``accepted``, as the verdict states them) with the candidates of
+    its round the campaign cannot tell from it, then the discovered term (the last accepted)
+    with its ``discovered_rivals``; each group with the run of ``runs``' kinds that would
+    tell them apart."""
+    final = [name_of(s.finding) for s in accepted]
+    leaders = {name_of(s.finding): s.finding for s in accepted}
+    pairs = [(r.best, found) for r in rounds
+             if r.best is not None and name_of(r.best.finding) in leaders
+             and (found := rivals(r.best, r.scored, final))]
+    if discovered_rivals:
+        pairs.append((accepted[-1], list(discovered_rivals)))
+    groups = []
+    for best, others in pairs:
+        names = [name_of(s.finding) for s in (best, *others)]
+        say(f"{' or '.join(names)}: the campaign cannot tell them apart; simulating the runs "
+            "that would")
+        groups.append(Alike((leaders[names[0]], *(s.finding for s in others)),
+                            next_run([explanation_of(s) for s in (best, *others)], runs)))
+    return groups
+
+
+def explanation_of(scored: Scored) -> Explanation:
+    """A scored candidate as an explanation: its name, its fitted model, and the run kinds
+    it reads, fitted on and checked on (a catalogued one's own: its fit's are the setups of
+    the runs it was fitted on)."""
+    candidate = CATALOGUE.get(scored.finding.cause, scored.fit.candidate)
+    return Explanation(name_of(scored.finding), scored.fit.params,
+                       (*candidate.runs, *candidate.held_out))

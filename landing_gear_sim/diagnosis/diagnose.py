@@ -24,10 +24,10 @@ from landing_gear_sim.calibration import differences
 from landing_gear_sim.calibration.actuator import LATE
 from landing_gear_sim.calibration.identify import Identification, Progress, identify
 from landing_gear_sim.calibration.measured import CHANNELS, simulate_all
-from landing_gear_sim.calibration.runs import ClassifiedRun, Selector, classify_all, fully_logged
+from landing_gear_sim.calibration.runs import ClassifiedRun, classify_all, fully_logged
 from landing_gear_sim.calibration.statistics import Estimate
 from landing_gear_sim.diagnosis import discovered, rounds
-from landing_gear_sim.diagnosis.alike import Alike, name_of, rivals
+from landing_gear_sim.diagnosis.alike import Alike, alike_groups, explanation_of, name_of
 from landing_gear_sim.diagnosis.catalogue import (
     CATALOGUE,
     Candidate,
@@ -165,7 +165,8 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     after = _interpretable(find_signatures(start.runs, model, simulated_after), start.runs)
     verdict, findings = _verdict(start, search.table, accepted, model, checks,
                                  simulated_after, after)
-    groups = _alike(search, accepted, extension.rivals if extension else (), start.runs, say)
+    groups = alike_groups(search.rounds, accepted, extension.rivals if extension else (),
+                          start.runs, say)
     settling = groups[0].next_run if groups else (
         _settling(start, search, extension.tried if extension else [], say)
         if verdict == INCONCLUSIVE else None)
@@ -267,36 +268,6 @@ def _extended(story: discovered.Story, search: rounds.Search, checks: list[Check
     return model, accepted, search.consistency.of(model), found
 
 
-def _alike(search: rounds.Search, accepted: list[Scored], discovered_rivals: Sequence[Scored],
-           runs: Sequence[ClassifiedRun], say: Progress) -> list[Alike]:
-    """Each accepted cause with the candidates of its round the campaign cannot tell from
-    it, and the run that would: the catalogue's rounds' then the discovered term's."""
-    final = [name_of(s.finding) for s in accepted]
-    leaders = {name_of(s.finding): s.finding for s in accepted}
-    pairs = [(r.best, found) for r in search.rounds
-             if r.best is not None and name_of(r.best.finding) in leaders
-             and (found := rivals(r.best, r.scored, final))]
-    if discovered_rivals:
-        pairs.append((accepted[-1], list(discovered_rivals)))
-    groups = []
-    for best, others in pairs:
-        names = [name_of(s.finding) for s in (best, *others)]
-        say(f"{' or '.join(names)}: the campaign cannot tell them apart; simulating the runs "
-            "that would")
-        explanations = [Explanation(name, s.fit.params, _kinds(s))
-                        for name, s in zip(names, (best, *others), strict=True)]
-        groups.append(Alike((leaders[names[0]], *(s.finding for s in others)),
-                            next_run(explanations, runs)))
-    return groups
-
-
-def _kinds(scored: Scored) -> tuple[Selector, ...]:
-    """The run kinds a scored candidate reads: fitted on, and checked on (a catalogued
-    one's own: its fit's are the setups of the runs it was fitted on)."""
-    candidate = CATALOGUE.get(scored.finding.cause, scored.fit.candidate)
-    return (*candidate.runs, *candidate.held_out)
-
-
 def _settling(start: _Start, search: rounds.Search, terms: Sequence[Scored], say: Progress
               ) -> NextRun | None:
     """The run that would settle an ``inconclusive`` verdict: the model as calibrated
@@ -308,7 +279,7 @@ def _settling(start: _Start, search: rounds.Search, terms: Sequence[Scored], say
     open_ = {name: s for name, s in fitted.items() if not s.finding.accepted
              and s.finding.delta_bic is not None and s.finding.delta_bic < BIC_THRESHOLD}
     explanations = [Explanation("the model as calibrated", start.calibrated),
-                    *(Explanation(name, s.fit.params, _kinds(s)) for name, s in open_.items())]
+                    *(explanation_of(s) for s in open_.values())]
     if len(explanations) < 2:
         return None
     say("simulating the runs that would settle it")

@@ -153,13 +153,15 @@ def generate_run(folder: Path, rig: RigParameters, scenario: sc.Scenario, seed: 
                  logger: Logger | None = None) -> Path:
     """One run of ``scenario`` as ``rig`` makes it (the run a diagnosis proposes to settle
     what a campaign left open), logged as ``logger`` logs, written to
-    ``folder/<scenario name>.csv``; returns its path. Its noise is drawn from ``seed``, as
-    a campaign's runs are; the rig, like a campaign's middle run, has worn no further."""
+    ``folder/next_<scenario name>.csv`` (a run of the campaign's own kind, a 10 bar stop
+    again, is diagnosed beside it under another name); returns its path. Its noise is drawn
+    from ``seed``, as a campaign's runs are; the rig, like a campaign's middle run, has worn
+    no further."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     logger = logger or Logger()
     rig.to_yaml(folder / GENERATING_FILE)
-    return _write(folder / f"{scenario.name}.csv", rig, scenario, logger, seed, OWN_RUN)
+    return _write(folder / f"next_{scenario.name}.csv", rig, scenario, logger, seed, OWN_RUN)
 
 
 def _write(path: Path, params: RigParameters, scenario: sc.Scenario, logger: Logger,

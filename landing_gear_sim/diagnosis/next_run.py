@@ -181,13 +181,15 @@ def _rate_hz(campaign: Sequence[ClassifiedRun]) -> float:
 def _closest(explanations: Sequence[Explanation], template: ClassifiedRun,
              noise: dict[str, float]) -> Apart | None:
     """The pair of ``explanations`` that the run ``template`` tells apart least; None
-    where an explanation cannot simulate it (its valve's range)."""
+    where an explanation cannot simulate it (its valve's range, or a candidate that
+    diverges there: its run would tell nothing of the rig)."""
     try:
         predicted = [simulate_run(template, e.params)[0] for e in explanations]
     except LandingGearSimError:
         return None
     channels = [c for c in channels_of(template) if c in noise]
-    if not channels:
+    if not channels or not all(np.all(np.isfinite(getattr(p, c)))
+                               for p in predicted for c in channels):
         return None
     pairs = [_apart(a, b, channels, noise, predicted[i], predicted[j])
              for (i, a), (j, b) in itertools.combinations(enumerate(explanations), 2)]

@@ -421,10 +421,17 @@ def _from_null(candidate: Candidate, runs: Sequence[ClassifiedRun], null: Candid
 
 def _at_bound(candidate: Candidate, fit: CandidateFit) -> bool:
     """A key pinned to the edge of its range: the data want the element off (or more
-    than it can give) — not evidence for it."""
-    for key, (low, high) in zip(candidate.keys, candidate.bounds, strict=True):
-        margin = 0.01 * (high - low)
-        if not low + margin < fit.values[key] < high - margin:
+    than it can give) — not evidence for it. A key pinned at its neutral value while
+    another carries the law is the element with a simpler law (a radius falling linearly
+    with the load: its F_z² coefficient at 0), not the element off."""
+    margins = [0.01 * (high - low) for low, high in candidate.bounds]
+    neutral = candidate.neutral or (math.nan,) * len(candidate.keys)
+    away = [abs(fit.values[k] - n) > m  # NaN: no neutral value, always away
+            or math.isnan(n) for k, n, m in zip(candidate.keys, neutral, margins, strict=True)]
+    for i, (key, (low, high)) in enumerate(zip(candidate.keys, candidate.bounds, strict=True)):
+        if not low + margins[i] < fit.values[key] < high - margins[i]:
+            if not away[i] and any(away[:i] + away[i + 1:]):
+                continue
             return True
     return False
 

@@ -94,6 +94,7 @@ def test_campaign_profile_writes_the_proposed_run_alone(tmp_path, capsys):
     folder = tmp_path / "next_run"
     assert main(["campaign", str(folder), "--profile", "steps", "--rig", "--seed", "3"]) == 0
     [path] = sorted(folder.glob("*.csv"))
+    assert path.name == "next_steps.csv"  # beside a campaign's own steps run
     run = classify_all([read_run(path)])[0]
     assert run.braking and run.kind is RunKind.BRAKE_OSCILLATING, run.kind
     assert main(["campaign", str(tmp_path / "x"), "--profile", "steps", "--shuffled"]) == 2

@@ -4,9 +4,9 @@ Two candidates scored from the same model explain the data alike when each met t
 evidence (ΔBIC and the held-out gain past their thresholds) and neither explains it
 :data:`~landing_gear_sim.diagnosis.discovered.PREDICTS_BETTER` times better than the other,
 by ΔBIC or held out: the factor past which the search already calls one predictor better.
-Differences of BIC are not odds between models that both miss the rig's law a little: a
-late pressure channel and a torque that leads the pressure differ by hundreds in BIC on a
-campaign of 10⁵ samples, for one that fits the pressure 98.5 % against 98.3 %.
+A difference of BIC is not odds between two models that both miss the rig's law a little:
+it is n ln(RSS₁/RSS₂), and at a campaign's 10⁵ samples residuals 0.1 % apart in their sum
+of squares differ by 100.
 
 The search keeps the better of the two (by ΔBIC in the catalogue's rounds, by relations and
 gain among discovered terms); its rival stands beside it in an :class:`Alike` group, with

@@ -60,9 +60,9 @@ def discovered(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: R
     """A discovered term, scored, for what ``checks`` and ``signatures`` (of ``model``)
     show (None when no family is called for), with the terms the campaign cannot tell from
     it: the families of REGISTRY by rank, until one rank accepts a term that leaves no later
-    family's relation violated (the better is kept: :func:`_better`). A wheel bearing's torque once read as a brake gain falling with
-    the pressure (rank 6, held out −45) and left free rolling violated; its own equation's
-    term, at rank 8, was never tried."""
+    family's relation violated (the better is kept: :func:`_better`). A wheel bearing's
+    torque once read as a brake gain falling with the pressure (rank 6, held out −45) and
+    left free rolling violated; its own equation's term, at rank 8, was never tried."""
     evidence = Evidence(runs, model, checks, signatures)
     violated = _Violated(runs)
     best: tuple[Family, Scored] | None = None

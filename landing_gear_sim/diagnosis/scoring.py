@@ -424,14 +424,13 @@ def _at_bound(candidate: Candidate, fit: CandidateFit) -> bool:
     than it can give) — not evidence for it. A key pinned at its neutral value while
     another carries the law is the element with a simpler law (a radius falling linearly
     with the load: its F_z² coefficient at 0), not the element off."""
+    values = [fit.values[k] for k in candidate.keys]
     margins = [0.01 * (high - low) for low, high in candidate.bounds]
-    neutral = candidate.neutral or (math.nan,) * len(candidate.keys)
-    away = [abs(fit.values[k] - n) > m  # NaN: no neutral value, always away
-            or math.isnan(n) for k, n, m in zip(candidate.keys, neutral, margins, strict=True)]
-    for i, (key, (low, high)) in enumerate(zip(candidate.keys, candidate.bounds, strict=True)):
-        if not low + margins[i] < fit.values[key] < high - margins[i]:
-            if not away[i] and any(away[:i] + away[i + 1:]):
-                continue
+    neutral = candidate.neutral or (math.nan,) * len(values)  # none: every key is away
+    away = [not abs(v - n) <= m for v, n, m in zip(values, neutral, margins, strict=True)]
+    for i, (value, (low, high)) in enumerate(zip(values, candidate.bounds, strict=True)):
+        pinned = not low + margins[i] < value < high - margins[i]
+        if pinned and (away[i] or not any(away[:i] + away[i + 1:])):
             return True
     return False
 

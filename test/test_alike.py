@@ -13,7 +13,7 @@ import pytest
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.calibration.runs import classify_all
 from landing_gear_sim.diagnosis.alike import (
-    ALIKE_FACTOR,
+    PREDICTS_BETTER,
     alike_groups,
     cannot_tell_apart,
     rivals,
@@ -56,7 +56,7 @@ def test_one_that_explains_twice_as_much_on_either_count_is_told_apart(gains, wh
     bic, held = gains
     first = _finding("actuator_delay", bic, held)
     more = {"delta_bic": bic, "held_out": held}
-    more[which] *= 1.05 * ALIKE_FACTOR
+    more[which] *= 1.05 * PREDICTS_BETTER
     second = _finding("actuator_dynamics", more["delta_bic"], more["held_out"])
     assert not cannot_tell_apart(first, second)
 

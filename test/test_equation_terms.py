@@ -195,7 +195,8 @@ def test_a_later_family_is_tried_when_the_accepted_term_leaves_its_relation_viol
         tried.clear()
         monkeypatch.setattr(d, "_violated_under", lambda s, runs, left=left: [
             type("Violated", (), {"relation": r})() for r in left])
-        assert d.discover([], reference, reference, {}, [], [], print) is scored[found]
+        assert d.discovered([], reference, reference, {}, [], [], print).scored \
+            is scored[found]
         assert tried == names
 
 

@@ -2,7 +2,7 @@
 
 Two candidates scored from the same model explain the data alike when each met the
 evidence (ΔBIC and the held-out gain past their thresholds) and neither explains it
-:data:`~landing_gear_sim.diagnosis.discovered.PREDICTS_BETTER` times better than the other,
+:data:`PREDICTS_BETTER` times better than the other,
 by ΔBIC or held out: the factor past which the search already calls one predictor better.
 A difference of BIC is not odds between two models that both miss the rig's law a little:
 it is n ln(RSS₁/RSS₂), and at a campaign's 10⁵ samples residuals 0.1 % apart in their sum
@@ -26,9 +26,9 @@ from landing_gear_sim.diagnosis.next_run import Explanation, NextRun, next_run
 from landing_gear_sim.diagnosis.rounds import Round
 from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, HELD_OUT_THRESHOLD, Scored
 
-ALIKE_FACTOR = 2.0
-"""Two gains within this factor of each other do not tell their explanations apart (the
-discovery's PREDICTS_BETTER)."""
+PREDICTS_BETTER = 2.0
+"""A gain this many times another's tells two explanations apart: within it they are alike,
+and past it the discovery keeps the better predictor whatever their relations say."""
 
 
 def met_evidence(finding: Finding) -> bool:
@@ -38,9 +38,9 @@ def met_evidence(finding: Finding) -> bool:
 
 
 def _within(first: float, second: float) -> bool:
-    """Two gains (negative: better) within :data:`ALIKE_FACTOR` of each other."""
+    """Two gains (negative: better) within :data:`PREDICTS_BETTER` of each other."""
     small, large = sorted((abs(first), abs(second)))
-    return large <= ALIKE_FACTOR * small
+    return large <= PREDICTS_BETTER * small
 
 
 def cannot_tell_apart(first: Finding, second: Finding) -> bool:
@@ -89,11 +89,10 @@ def alike_groups(rounds: Sequence[Round], accepted: Sequence[Scored],
     its round the campaign cannot tell from it, then the discovered term (the last accepted)
     with its ``discovered_rivals``; each group with the run of ``runs``' kinds that would
     tell them apart."""
-    final = [name_of(s.finding) for s in accepted]
     leaders = {name_of(s.finding): s.finding for s in accepted}
     pairs = [(r.best, found) for r in rounds
              if r.best is not None and name_of(r.best.finding) in leaders
-             and (found := rivals(r.best, r.scored, final))]
+             and (found := rivals(r.best, r.scored, list(leaders)))]
     if discovered_rivals:
         pairs.append((accepted[-1], list(discovered_rivals)))
     groups = []

@@ -18,7 +18,7 @@ from dataclasses import dataclass, replace
 from landing_gear_sim.calibration.identify import Progress
 from landing_gear_sim.calibration.measured import CHANNELS, channels_of, simulate_all
 from landing_gear_sim.calibration.runs import ClassifiedRun
-from landing_gear_sim.diagnosis.alike import rivals
+from landing_gear_sim.diagnosis.alike import PREDICTS_BETTER, rivals
 from landing_gear_sim.diagnosis.consistency import check_campaign
 from landing_gear_sim.diagnosis.families import REGISTRY, Evidence, Family, Proposal
 from landing_gear_sim.diagnosis.families.wheel_skew import wheel_lags
@@ -34,15 +34,6 @@ from landing_gear_sim.diagnosis.scoring import (
 from landing_gear_sim.diagnosis.signatures import find_signatures
 from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model.parameters import RigParameters
-
-PREDICTS_BETTER = 2.0  # a held-out gain this many times another's outweighs its relations
-
-
-def discover(runs: Sequence[ClassifiedRun], model: RigParameters, datasheet: RigParameters,
-             scales: Scales, signatures: Sequence[Signature], checks: Sequence[Check],
-             say: Progress) -> Scored | None:
-    """:func:`discovered`'s term alone."""
-    return discovered(runs, model, datasheet, scales, signatures, checks, say).scored
 
 
 @dataclass(frozen=True)

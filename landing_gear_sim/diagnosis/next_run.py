@@ -27,6 +27,7 @@ from landing_gear_sim.calibration.measured import channel_words, channels_of, si
 from landing_gear_sim.calibration.noise import noise_std
 from landing_gear_sim.calibration.runs import ClassifiedRun, Selector, classified, matches
 from landing_gear_sim.diagnosis.misfit import equation_of
+from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD
 from landing_gear_sim.errors import LandingGearSimError
 from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import RigParameters
@@ -34,7 +35,7 @@ from landing_gear_sim.model.runspec import PROFILES, RunSpec, build_scenario
 from msg_tools.run import Run
 from msg_tools.units import PA_PER_BAR
 
-SETTLES = 10.0
+SETTLES = -BIC_THRESHOLD
 """A log-likelihood ratio past which a run tells two explanations apart ("very strong"
 evidence, the diagnosis's own ΔBIC threshold)."""
 

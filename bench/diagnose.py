@@ -10,7 +10,9 @@ its cache, its first call excluded). "passes" is the diagnosis's time over one p
 simulation pass of the campaign (every run re-simulated with its measured input) in that
 same interpreter: a ratio that holds from machine to machine. With ``--against`` (the code
 before, a ``git worktree``) each campaign is diagnosed by both, one after the other, and
-"faster" is the time before over the time now.
+"faster" is the time before over the time now. "sim" counts the runs the diagnosis
+simulated (in this process and its fits' processes), in whole-campaign passes; "again" how
+many of those a parameter set had simulated already (issue 61: each (parameters, run) once).
 
 Targets (issue 61, a quiet 2-core machine): campaign_v1 ≤ 30 passes, every campaign ≤ 50,
 peak memory no higher than before; the verdicts the same.
@@ -49,8 +51,9 @@ CASES: dict[str, tuple[dict, tuple[str, ...], tuple[str, ...] | None]] = {
 }
 # what a fresh interpreter of the checkout measured runs (the API it uses is the same before)
 MEASURE = """
-import json, resource, sys, time
+import hashlib, json, os, resource, sys, tempfile, time
 from pathlib import Path
+from landing_gear_sim.calibration import measured
 from landing_gear_sim.calibration.measured import simulate_all
 from landing_gear_sim.diagnosis.diagnose import diagnose
 from landing_gear_sim.model.parameters import load_parameters
@@ -69,14 +72,28 @@ except ImportError:
 start = time.perf_counter()
 simulate_all(runs, base)
 one_pass = time.perf_counter() - start
+# every simulation of a run with a parameter set, in this process and the forked fits':
+# a line each, (parameters, run) hashed, appended to one file (O_APPEND: whole lines)
+log = os.path.join(tempfile.mkdtemp(), "simulated")
+plain = measured.simulate
+def counted(params, scenario, *args, **kwargs):
+    key = hashlib.blake2b(params.vector().tobytes() + scenario.name.encode()
+                          + scenario.current_a.tobytes(), digest_size=12).hexdigest()
+    fd = os.open(log, os.O_WRONLY | os.O_APPEND | os.O_CREAT)
+    os.write(fd, (key + "\\n").encode())
+    os.close(fd)
+    return plain(params, scenario, *args, **kwargs)
+measured.simulate = counted
 start = time.perf_counter()
 result = diagnose(runs, base, without=without)
 elapsed = time.perf_counter() - start
+keys = Path(log).read_text().split()
 own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 worker = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
 found = {k: v for f in result.findings[:1] for k, v in f.parameters.items()}
 print(json.dumps({"verdict": result.verdict, "seconds": elapsed, "pass_s": one_pass,
-                  "peak_mb": own + 2 * worker, "found": found}))
+                  "peak_mb": own + 2 * worker, "found": found, "runs": len(runs),
+                  "simulated": len(keys), "distinct": len(set(keys))}))
 """
 
 
@@ -96,13 +113,21 @@ def _row(name: str, folder: Path, without: tuple[str, ...], before: Path | None)
     target = TARGET_V1_PASSES if name.startswith("campaign_v1") else TARGET_ANY_PASSES
     found = ", ".join(f"{k} = {v:.4g}" for k, v in now["found"].items())
     text = (f"{name:38s} {now['verdict']:16s} {now['seconds']:6.1f} s {passes:5.0f} "
-            f"{target / passes:5.2f}x {now['peak_mb']:6.0f} MB")
+            f"{target / passes:5.2f}x {now['peak_mb']:6.0f} MB {_simulated(now)}")
     if before is not None:
         then = _measure(before, folder, without)
         same = "same" if then["verdict"] == now["verdict"] else f"was {then['verdict']}"
         text += (f"  | before {then['seconds']:6.1f} s {then['seconds'] / then['pass_s']:5.0f}"
-                 f" {then['seconds'] / now['seconds']:5.2f}x {then['peak_mb']:6.0f} MB {same}")
+                 f" {then['seconds'] / now['seconds']:5.2f}x {then['peak_mb']:6.0f} MB "
+                 f"{_simulated(then)} {same}")
     print(f"{text}  {found}", flush=True)
+
+
+def _simulated(measured: dict) -> str:
+    """The runs simulated, as whole-campaign passes, and those simulated again with the
+    same parameters (issue 61: each (parameters, run) once)."""
+    simulated, again = measured["simulated"], measured["simulated"] - measured["distinct"]
+    return f"{simulated / measured['runs']:5.0f} sim {again:4d} again"
 
 
 def main() -> None:
@@ -110,7 +135,8 @@ def main() -> None:
     parser.add_argument("--against", type=Path, help="the code before (a checkout)")
     args = parser.parse_args()
     print("diagnose on full campaigns: time, passes (time over one simulation pass) and "
-          "the passes' ratio to the target (> 1 beats it), peak memory"
+          "the passes' ratio to the target (> 1 beats it), peak memory, the runs simulated "
+          "(in whole-campaign passes) and how many of them again with the same parameters"
           + ("; then the code before and how much faster now" if args.against else ""))
     base = load_parameters()
     for i, (name, (effect, without, names)) in enumerate(CASES.items()):

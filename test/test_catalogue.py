@@ -239,6 +239,20 @@ def test_a_fit_simulates_its_start_once(reference, tmp_path, monkeypatch):
     assert len(set(simulated)) == len(simulated) > 8
 
 
+def test_a_start_both_references_give_is_simulated_and_probed_once(reference, tmp_path,
+                                                                   monkeypatch):
+    """A fit starts from the calibrated model and from the datasheet. Where the two agree on
+    the free parameters they give one start twice: it was ranked twice and probed twice, a
+    quarter of a discovered term's simulations (issue 61: nothing computed twice)."""
+    runs, _ = _hidden(reference, tmp_path, 26, lambda rng: {
+        "elements.actuator_delay": True, "actuator.delay_s": 0.008}, ACTUATOR_RUNS)
+    calibrated = identify(runs, reference).params
+    simulated = _counting(monkeypatch)
+    fit = fit_candidate(CATALOGUE["actuator_delay"], runs, calibrated, datasheet=calibrated)
+    assert len(set(simulated)) == len(simulated) > 8
+    assert fit.values["actuator.delay_s"] == pytest.approx(0.008, abs=1e-3)
+
+
 def test_a_candidate_tried_again_starts_where_it_ended(reference, tmp_path, monkeypatch):
     """A candidate a round leaves for the next (it helped, another helped more) was fitted
     from its catalogue starts again: I02's fade took 20 evaluations and 15 Jacobians in

@@ -358,7 +358,7 @@ def _best_start(candidate: Candidate, problem: _Problem, points: list[np.ndarray
     lowest cost within START_RATIO of the best (``resumed``: where it ended before, alone
     when it ranks first)."""
     # a start the model does not survive (an unstable valve: inf or nan) is no start
-    at_points = problem.residuals(points)
+    at_points = _once_each(problem.residuals, points)
     initial = [cost if math.isfinite(cost := float(np.sum(r ** 2))) else math.inf
                for r in at_points]
     if not math.isfinite(min(initial)):
@@ -369,11 +369,26 @@ def _best_start(candidate: Candidate, problem: _Problem, points: list[np.ndarray
     if len(order) == 1:
         return points[order[0]], at_points[order[0]], None
     # successive halving: the starts' first steps tell the basins apart; running each to
-    # the end cost twice the time and always ended on the same optimum
-    probes = [_optimise(problem.objective((points[i], at_points[i], None)), points[i],
-                        PROBE_ITERATIONS) for i in order]
-    probe = min(probes, key=lambda fit: fit.cost)
+    # the end cost twice the time and always ended on the same optimum. Two references
+    # that agree on the free parameters give one start twice: its probe is one probe
+    probes: dict[bytes, OptimizeResult] = {}
+    for i in order:
+        if points[i].tobytes() not in probes:
+            probes[points[i].tobytes()] = _optimise(
+                problem.objective((points[i], at_points[i], None)), points[i],
+                PROBE_ITERATIONS)
+    probe = min(probes.values(), key=lambda fit: fit.cost)
     return probe.x, probe.fun, probe.jac
+
+
+def _once_each(residuals: Callable[[Sequence[np.ndarray]], list[np.ndarray]],
+               points: Sequence[np.ndarray]) -> list[np.ndarray]:
+    """``residuals`` at ``points``, a point given twice simulated once (a start each
+    reference gives alike: a discovered term's fit had simulated a quarter of its runs
+    twice)."""
+    unique = list({p.tobytes(): p for p in points}.values())
+    found = dict(zip((p.tobytes() for p in unique), residuals(unique), strict=True))
+    return [found[p.tobytes()] for p in points]
 
 
 def _fitted(candidate: Candidate, problem: _Problem, best: OptimizeResult,

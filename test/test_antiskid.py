@@ -15,7 +15,7 @@ from antiskid.closed_loop import (
     with_surface,
 )
 from antiskid.errors import ControllerError
-from antiskid.metrics import braking_metrics, peak_friction
+from antiskid.metrics import braking_metrics, peak_friction, release_cycles
 from landing_gear_sim.cli import main
 from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
@@ -104,6 +104,28 @@ def test_metrics_measure_the_pressure_cycling_and_flag_the_gear_walk(reference, 
     metrics = braking_metrics(run, reference)
     assert metrics.cycling_frequency_hz == pytest.approx(hz, rel=0.1)
     assert metrics.cycling_near_gear_walk is near_gear_walk
+
+
+@pytest.mark.parametrize("kind", ["walk", "noisy cycles", "plateaus"])
+def test_release_cycles_are_the_peaks_scipy_finds_by_their_prominence(kind):
+    """The cycles are counted in one pass (scipy.signal's import had been 0.9 s of the
+    ``metrics`` command's 2.3 s): the same peaks as find_peaks' prominence, on random walks,
+    noisy pressure cycles, and plateaus quantised like a logger's counts."""
+    import scipy.signal
+
+    rng = np.random.default_rng(["walk", "noisy cycles", "plateaus"].index(kind))
+    for _ in range(200):
+        n = int(rng.integers(2, 400))
+        if kind == "walk":
+            x = np.cumsum(rng.normal(size=n))
+        else:
+            t = np.linspace(0.0, rng.uniform(1.0, 20.0), n)
+            x = 3.0 * np.sin(2 * np.pi * t) + rng.normal(0.0, rng.uniform(0.05, 1.5), n)
+            if kind == "plateaus":
+                x = np.round(x * rng.uniform(0.5, 2.0))
+        prominence = float(rng.uniform(0.5, 4.0))
+        peaks, _ = scipy.signal.find_peaks(x, prominence=prominence)
+        assert release_cycles(x, prominence) == len(peaks), (x.tolist(), prominence)
 
 
 def test_peak_friction_of_the_reference_curve(reference):

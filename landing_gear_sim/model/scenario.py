@@ -13,7 +13,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.optimize
 
 from landing_gear_sim.errors import ScenarioError
 from landing_gear_sim.model import keys as K
@@ -298,6 +297,8 @@ def _map_root(params: RigParameters, target_pa: float) -> float:
     """The current [A] at which the model's own static map (its cubic term and slot
     included: no closed-form inverse) first reaches ``target_pa``, bracketed on a grid of
     the valve's range (inf: it never does)."""
+    import scipy.optimize  # here, as scipy.signal in sine_sweep: 0.6 s of a command's start
+
     from landing_gear_sim.model import elements as el  # numba: loaded for a bent map only
 
     p = params.vector()

@@ -54,6 +54,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/controllers.py
 	$(BIN)/python bench/diagnose.py
 	$(BIN)/python bench/sensitivity.py
+	$(BIN)/python bench/jacobians.py
 	$(BIN)/python bench/io.py
 	$(BIN)/python bench/montecarlo.py
 	$(BIN)/python bench/history.py

@@ -33,8 +33,8 @@ the verdict guard's 74 campaigns the plant's exact Jacobians moved discovered la
 (U01's μ_B² became μ_B·√λ with a larger unexplained deviation, 1493's and 1578's lost a
 term, I09's drift moved 5.6σ of its own) while 1512 went from unexplained to discovered:
 scipy's forward differences take steps that straddle the residual's jumps (a stop's last
-sample, a lock, a sign), exact derivatives do not, and the fits end elsewhere. (That guard
-ran before e537605, which fixed derivatives that could read NaN: it is to be run again.)
+sample, a lock, a sign), exact derivatives do not, and the fits end elsewhere. (Run again
+after e537605 fixed derivatives that could read NaN: 14 of the 74 differ, the same set.)
 Until that is understood the fits keep differences."""
 
 Derivatives = Callable[[np.ndarray], "tuple[np.ndarray, np.ndarray] | None"]

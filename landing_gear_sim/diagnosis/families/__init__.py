@@ -6,7 +6,7 @@ the wheel's torque balance, a channel's measurement — by a term held in a slot
 says which violated relations call for it, proposes candidates from what the campaign shows
 and writes its law with the fitted values; it also says how to hide its effect in a
 generated campaign, so that the tests and the benchmark parametrise over :data:`REGISTRY`.
-The diagnosis tries them in this order (:func:`~..discovered.discover`): the valve and the
+The diagnosis tries them in this order (:func:`~..discovered.discovered`): the valve and the
 channels first, since what they misread distorts every other relation, then the wheel's
 equation; last the equations' generic slots (:mod:`.equation_terms`), for what no named
 family holds. Adding a family: one module here (its words included: the report reads

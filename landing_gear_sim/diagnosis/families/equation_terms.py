@@ -164,7 +164,7 @@ class WheelTerms(EquationTerms):
     name = "wheel_equation"
     library = eq.WHEEL
     # the tyre pushes a bearing's torque in free rolling; left violated by a brake gain law
-    # fitted in its place (rank 6), it has this family tried (discovered.discover)
+    # fitted in its place (rank 6), it has this family tried (discovered.discovered)
     also_breaks = (Relation.FREE_ROLLING,)
     free = (K.BRAKE_GAIN_N_M_PER_PA, *FRICTION)
     channels = WHEEL

@@ -29,13 +29,14 @@ DIFF_STEP = 1e-4  # relative, as scipy's diff_step (the fits were tuned with it)
 
 MODEL_DERIVATIVES = False
 """Whether fits walk on the model's own derivatives where it gives them (issue 61). Off: on
-the verdict guard's 74 campaigns the plant's exact Jacobians moved discovered laws' terms
-(U01's μ_B² became μ_B·√λ with a larger unexplained deviation, 1493's and 1578's lost a
-term, I09's drift moved 5.6σ of its own) while 1512 went from unexplained to discovered:
-scipy's forward differences take steps that straddle the residual's jumps (a stop's last
-sample, a lock, a sign), exact derivatives do not, and the fits end elsewhere. (Run again
-after e537605 fixed derivatives that could read NaN: 14 of the 74 differ, the same set.)
-Until that is understood the fits keep differences."""
+the verdict guard's 74 campaigns the plant's exact Jacobians change 14 answers (run again
+after e537605 fixed derivatives that could read NaN), mostly parameters by 0.1-3 %, four
+discovered laws' terms. Neither path ends on the better optimum everywhere (the final
+model's cost over every run, ``bench/jacobians.py``): U01's law became μ_B·√λ at 0.62 times
+the cost of μ_B², 1578's kept its term at 1.93 times the cost. scipy's forward differences
+take steps that straddle the residual's jumps (a stop's last sample, a lock, a sign), exact
+derivatives do not, and the fits end in other basins. The fits keep differences until
+they end no worse on the plant's derivatives."""
 
 Derivatives = Callable[[np.ndarray], "tuple[np.ndarray, np.ndarray] | None"]
 """The residual at a point and its Jacobian, from one pass of the model (None: the model

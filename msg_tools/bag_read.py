@@ -19,6 +19,7 @@ import numpy as np
 from rosbags.highlevel import AnyReader
 
 from .bag_fields import Source, resolve
+from .bag_files import storage_files
 from .bag_io import TYPESTORE
 from .bag_recover import recovered
 from .checks import check_plausible
@@ -27,13 +28,6 @@ from .derivative import speed_from_angle
 from .errors import RunFormatError
 from .mapping import DEFAULT_MAPPING, Mapping
 from .run import Run
-
-STORAGE_SUFFIXES = (".mcap", ".db3")
-
-
-def storage_files(folder: Path) -> list[Path]:
-    """The rosbag2 storage files (``.mcap``, ``.db3``) directly in ``folder``, sorted."""
-    return sorted(p for p in folder.iterdir() if p.suffix.lower() in STORAGE_SUFFIXES)
 
 
 def bag_paths(path: Path) -> list[Path]:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .bag_read import STORAGE_SUFFIXES, read_bag, storage_files
+from .bag_files import STORAGE_SUFFIXES, storage_files
 from .binary_tables import READERS
 from .columns import run_from_table
 from .csv_io import read_csv, read_named, run_name
@@ -76,6 +76,8 @@ def _read_any(path: Path, mapping: Mapping | None, name: str | None) -> Run:
         raise RunFormatError(f"{path}: no such file or folder")
     kind = _kind(path)
     if kind == "bag":
+        from .bag_read import read_bag  # rosbags: imported for a bag only
+
         return read_bag(path, name, mapping)
     if kind == "text":
         return read_csv(path, name, mapping)

@@ -2,8 +2,8 @@
 
 Two candidates scored from the same model explain the data alike when each met the
 evidence (ΔBIC and the held-out gain past their thresholds) and neither explains it
-:data:`PREDICTS_BETTER` times better than the other,
-by ΔBIC or held out: the factor past which the search already calls one predictor better.
+:data:`PREDICTS_BETTER` times better than the other, by ΔBIC or held out: the factor past
+which the search already calls one predictor better.
 A difference of BIC is not odds between two models that both miss the rig's law a little:
 it is n ln(RSS₁/RSS₂), and at a campaign's 10⁵ samples residuals 0.1 % apart in their sum
 of squares differ by 100.

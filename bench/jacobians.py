@@ -6,10 +6,10 @@ Run: ``python bench/jacobians.py [CAMPAIGN ...]`` (a campaign folder, with its
 ``datasheet.yaml`` when it has one; by default ``../shared/data``'s campaign_v1 and U01, when
 present). Each path diagnoses in a fresh interpreter of this
 checkout, the plant's derivatives compiled before the clock starts. The cost is what the
-fits minimise, taken over every run: Σ over runs, channels and samples of (model − log)² /
-σ², σ each channel's logger noise read from the run. Where the two paths answer differently,
-the lower cost says which ended on the better optimum; "on/off" is the cost with the
-plant's derivatives over the cost with differences.
+fits minimise (``diagnosis.objective.scaled_error``), taken over every run and channel:
+Σ (model − log)² / σ², σ each channel's logger noise read from the run. Where the two
+paths answer differently, the lower cost says which ended on the better optimum; "on/off"
+is the cost with the plant's derivatives over the cost with differences.
 """
 
 from __future__ import annotations
@@ -35,6 +35,7 @@ from landing_gear_sim.calibration.measured import CHANNELS, channels_of, simulat
 from landing_gear_sim.calibration.runs import classify_all
 from landing_gear_sim.diagnosis.catalogue import noise_scales
 from landing_gear_sim.diagnosis.diagnose import diagnose
+from landing_gear_sim.diagnosis.objective import scaled_error
 from landing_gear_sim.model.parameters import load_parameters
 from landing_gear_sim.model.sensitivity import prepare_kernels
 from msg_tools.io import read_runs
@@ -51,13 +52,8 @@ seconds = time.perf_counter() - start
 classified = classify_all(runs)
 scales = noise_scales(classified, tuple(CHANNELS))
 def cost(params):
-    total = 0.0
-    for run, model in zip(classified, simulate_all(classified, params), strict=True):
-        for channel in channels_of(run):
-            if scales.get((run.name, channel)):
-                error = (getattr(model, channel) - getattr(run, channel))[run.compared]
-                total += float(np.sum((error / scales[(run.name, channel)]) ** 2))
-    return total
+    return sum(float(np.sum(scaled_error([run], [model], channels_of(run), scales) ** 2))
+               for run, model in zip(classified, simulate_all(classified, params), strict=True))
 print(json.dumps({"verdict": result.verdict, "seconds": seconds,
                   "cost": cost(result.extended), "calibrated": cost(result.calibrated),
                   "findings": [[f.cause, f.family, f.term, f.delta_bic, f.held_out]

@@ -65,6 +65,10 @@ def test_a_campaign_without_extra_effect_gives_none(reference, tmp_path):
     result = diagnose(runs, reference)
     assert result.verdict == "none", [f.evidence for f in result.findings]
     assert result.findings == []
+    # no fade fitted where the brake gain does not fall with the energy absorbed (issue 61)
+    assert "brake_fade" not in {c.cause for c in result.candidates}
+    assert any(p.startswith("brake_fade: not fitted: the brake gain does not fall")
+               for p in result.problems), result.problems
     assert result.consistency_calibrated and not any(
         c.violated for c in result.consistency_calibrated)
 

@@ -247,6 +247,7 @@ def _calibrated_start(runs: Sequence[Run], base: RigParameters, without: Sequenc
     scales = noise_scales(kept, tuple(CHANNELS))
     pending, skipped = _testable(scaled_to_rig(candidates_for(start, without), kept, start),
                                  kept, problems, say)
+    pending = _evidenced(pending, kept, calibration.params, problems, say)
     return _Start(kept, start, without, calibration, simulated, baseline, tried, scales,
                   pending, skipped, problems)
 
@@ -337,6 +338,23 @@ def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],
         else:
             testable.append(candidate)
     return testable, [c for c in skipped if _could_show(CATALOGUE[c], runs)]
+
+
+def _evidenced(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],
+               calibrated: RigParameters, problems: list[str], say: Progress
+               ) -> list[Candidate]:
+    """The candidates whose sign the runs may show under the ``calibrated`` model; every
+    other noted in ``problems`` with what the runs show instead (a fit that cannot pass the
+    evidence costs as much as one that can)."""
+    shown = []
+    for candidate in candidates:
+        reason = candidate.evidence(runs, calibrated) if candidate.evidence else ""
+        if reason:
+            problems.append(f"{candidate.cause}: not fitted: {reason}")
+            say(f"{candidate.cause}: not fitted, {reason}")
+        else:
+            shown.append(candidate)
+    return shown
 
 
 def _could_show(candidate: Candidate, runs: Sequence[ClassifiedRun]) -> bool:

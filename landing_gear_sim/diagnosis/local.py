@@ -88,19 +88,38 @@ VARIABLES: dict[str, str] = {"wheel speed": "rad/s", "vertical load": "N", "pres
 
 def local_gains(runs: Sequence[ClassifiedRun], params: RigParameters) -> list[LocalGain]:
     """Band estimates over the campaign for each of VARIABLES, then along each run."""
-    per_run = [(r.name, _samples(br.prepare(r, params), params)) for r in runs if r.braking]
+    per_run = _per_run(runs, params)
     if not per_run:
         return []
-    samples = [s for _, s in per_run]
-    pooled = _Samples(np.concatenate([s.torque for s in samples]),
-                      np.concatenate([s.model for s in samples]),
-                      {k: np.concatenate([s.variables[k] for s in samples])
-                       for k in samples[0].variables})
+    pooled = _pooled([s for _, s in per_run])
     found = [g for variable, unit in VARIABLES.items()
              if (g := _banded(pooled, variable, unit, "campaign", _quantile_bands)) is not None]
     found.extend(g for name, s in per_run
                  if (g := _banded(s, "time in run", "s", name, _windows)) is not None)
     return found
+
+
+def campaign_gain(runs: Sequence[ClassifiedRun], params: RigParameters, variable: str
+                  ) -> LocalGain | None:
+    """The band estimates over the campaign for ``variable`` (one of VARIABLES) alone (None:
+    no braking run, or too few bands)."""
+    per_run = _per_run(runs, params)
+    if not per_run:
+        return None
+    return _banded(_pooled([s for _, s in per_run]), variable, VARIABLES[variable],
+                   "campaign", _quantile_bands)
+
+
+def _per_run(runs: Sequence[ClassifiedRun], params: RigParameters
+             ) -> list[tuple[str, _Samples]]:
+    return [(r.name, _samples(br.prepare(r, params), params)) for r in runs if r.braking]
+
+
+def _pooled(samples: Sequence[_Samples]) -> _Samples:
+    return _Samples(np.concatenate([s.torque for s in samples]),
+                    np.concatenate([s.model for s in samples]),
+                    {k: np.concatenate([s.variables[k] for s in samples])
+                     for k in samples[0].variables})
 
 
 Bands = Callable[[np.ndarray], list[np.ndarray]]

@@ -65,10 +65,12 @@ def test_a_campaign_without_extra_effect_gives_none(reference, tmp_path):
     result = diagnose(runs, reference)
     assert result.verdict == "none", [f.evidence for f in result.findings]
     assert result.findings == []
-    # no fade fitted where the brake gain does not fall with the energy absorbed (issue 61)
-    assert "brake_fade" not in {c.cause for c in result.candidates}
-    assert any(p.startswith("brake_fade: not fitted: the brake gain does not fall")
-               for p in result.problems), result.problems
+    # no fade fitted where the brake gain does not fall with the energy absorbed, no
+    # relaxation where the tyre's force does not lag its curve (issue 61)
+    assert not {"brake_fade", "tire_relaxation"} & {c.cause for c in result.candidates}
+    notes = "\n".join(result.problems)
+    assert "brake_fade: not fitted: the brake gain does not fall" in notes, notes
+    assert "tire_relaxation: not fitted: the tyre's force does not lag" in notes, notes
     assert result.consistency_calibrated and not any(
         c.violated for c in result.consistency_calibrated)
 

@@ -31,12 +31,14 @@ MODEL_DERIVATIVES = False
 """Whether fits walk on the model's own derivatives where it gives them (issue 61). Off: on
 the verdict guard's 74 campaigns the plant's exact Jacobians change 14 answers (run again
 after e537605 fixed derivatives that could read NaN), mostly parameters by 0.1-3 %, four
-discovered laws' terms. Neither path ends on the better optimum everywhere (the final
-model's cost over every run, ``bench/jacobians.py``): U01's law became μ_B·√λ at 0.62 times
-the cost of μ_B², 1578's kept its term at 1.93 times the cost. scipy's forward differences
-take steps that straddle the residual's jumps (a stop's last sample, a lock, a sign), exact
-derivatives do not, and the fits end in other basins. The fits keep differences until
-they end no worse on the plant's derivatives."""
+discovered laws' terms. By the final model's cost over every run (``bench/jacobians.py``)
+U01's law became μ_B·√λ at 0.62 times the cost of μ_B², and 1578's kept its term at 1.93
+times the cost, but there both paths had stopped on their budget: given room, the
+derivatives end 4.6 times lower than differences, and differences started there stay
+(docs/diagnosis.md, "Time"). scipy's forward differences take steps that straddle the
+residual's jumps (a stop's last sample, a lock, a sign); exact derivatives do not. A dual
+pass costs 2.7-5.3 plain ones, so the switch buys 5 % of a diagnosis's time, not the
+passes issue 61 counts on; the fits keep differences, on which every verdict was kept."""
 
 Derivatives = Callable[[np.ndarray], "tuple[np.ndarray, np.ndarray] | None"]
 """The residual at a point and its Jacobian, from one pass of the model (None: the model

@@ -19,6 +19,7 @@ generator that lock, logged as six loggers, read under 0.06 %.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -28,6 +29,7 @@ from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration import friction
 from landing_gear_sim.calibration.friction import tyre_carries
 from landing_gear_sim.calibration.noise import channel_noise
+from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.calibration.slots import Slot, seen
 from landing_gear_sim.calibration.statistics import linear_std
 from landing_gear_sim.diagnosis.equations.equation import Declared, Equation
@@ -36,10 +38,18 @@ from landing_gear_sim.diagnosis.library import (
     about_run_mean,
 )
 from landing_gear_sim.diagnosis.relations import Check, Checking, Reads, Relation
-from landing_gear_sim.diagnosis.selection import Rows, Term, basis_terms, term_columns
+from landing_gear_sim.diagnosis.selection import (
+    Rows,
+    Selected,
+    Term,
+    basis_terms,
+    fit_terms,
+    term_columns,
+)
 from landing_gear_sim.diagnosis.terms import Shaped
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import elements as el
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import (
     curve_at,
@@ -203,6 +213,29 @@ TYRE = TyreLibrary()
 
 
 LOCKED_TYRE = LockedTyreLibrary()  # the tyre's slot read where the wheel locks; not a check
+
+
+def _lag(b: br.Braking, params: RigParameters) -> np.ndarray:
+    """−Ḟ_x / (v_h F_z): a relaxing tyre's force lags its steady one by σ/v_h
+    (σ/v_h·Ḟ_x = F_z·μ − F_x), so the tyre's error, read with no relaxation, is σ times it."""
+    hub = np.maximum(br.hub_speed(b, params), el.MIN_HUB_SPEED_M_S)
+    return -np.gradient(b.force, b.time_s) / hub / np.maximum(b.load, 1.0)
+
+
+RELAXATION = Term(K.TYRE_RELAXATION_LENGTH_M, "·lag", "m", math.inf, values=_lag)
+"""The relaxation length σ as a term of the tyre's error (its variable −Ḟ_x / (v_h F_z))."""
+
+
+def relaxation_read(runs: Sequence[ClassifiedRun], params: RigParameters) -> Selected | None:
+    """The relaxation length the tyre's error over the curve's samples reads under
+    ``params`` (a model whose tyre does not relax): that error regressed on the lag alone,
+    beside the curve's derivatives (the calibration may bend it), with its t (None: no
+    samples). The project's generator's 3, 8 and 20 cm read 2.8-3.0, 7.7-7.9 and 19.6-19.7
+    cm, at t 2.4-21."""
+    rows = [r for run in runs if run.braking
+            and (r := TYRE.rows(br.prepare(run, params), params, [RELAXATION])) is not None]
+    fitted = fit_terms([RELAXATION], rows) if rows else None
+    return fitted.selected[0] if fitted and fitted.selected else None
 
 
 DECLARED = Declared(f"{LAW} (tyre force)", "wheel_speed_rad_s", (

@@ -55,6 +55,23 @@ def test_every_candidate_says_why_it_was_or_was_not_accepted():
     assert _rejection(-97.0, HeldOut(delta=-50.0, gain=2.0), False, "") == ""
 
 
+def test_a_candidate_that_makes_a_compared_channel_worse_held_out_says_which():
+    """Issue 41's campaign 1561: a relaxation fitted to a friction peak that sharpens with
+    speed made the held-out force channel 85.8 → 86.1 % and the wheel's 34.0 → 28.0 %, the
+    log-likelihood better by 64 on the force's many more samples, and was named. (That
+    campaign's tyre force does not lag its curve: the relaxation is no longer fitted there,
+    issue 61.) The rule that rejects it, on its numbers."""
+    from landing_gear_sim.diagnosis.scoring import HeldOut, _rejection
+
+    held = HeldOut(delta=-64.0, before={"longitudinal_force_n": 85.8, "wheel_speed_rad_s": 34.0},
+                   after={"longitudinal_force_n": 86.1, "wheel_speed_rad_s": 28.0}, gain=0.3)
+    reason = _rejection(-200.0, held, False, "")
+    assert reason.startswith("no: it makes the held-out runs' wheel speed worse by 6.00"), reason
+    # a loss within what it gains elsewhere (or under a point) is no rejection
+    slight = dataclasses.replace(held, after={**held.after, "wheel_speed_rad_s": 33.5})
+    assert _rejection(-200.0, slight, False, "") == ""
+
+
 def test_the_consistency_chart_colours_only_what_the_verdict_calls_violated(tmp_path):
     """'vertical load follows F_z0 − k_L v²' drawn orange at 13σ past the 6σ line beside a
     verdict of 0 violated (its deviation was under the physical floor). Each bar is now its

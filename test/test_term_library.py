@@ -552,8 +552,10 @@ def test_a_cause_that_makes_a_compared_channel_worse_held_out_is_not_named(refer
     generate_campaign(tmp_path, rig, 1561, logger=Logger(encoder_counts=64, dropout_s=0.05))
     result = diagnose(read_campaign(tmp_path).runs, reference)
     assert result.verdict not in CATALOGUE, result.verdict
-    relaxation = next(f for f in result.candidates if f.cause == "tire_relaxation")
-    assert "wheel speed worse" in relaxation.reason, relaxation.reason
+    # the relaxation it was named is not fitted: the tyre's force does not lag its curve
+    # (issue 61; the held-out rule that rejected it: test_report_reads_right)
+    assert "tire_relaxation: not fitted: the tyre's force does not lag" in "\n".join(
+        result.problems), result.problems
     # nor `none` (stop 55 to 56) nor `unexplained` (stop 57): its locks slide with less grip
     # the faster, and the tyre's terms read there, where the slip is 1 through any encoder
     found = _first(result, "tyre")

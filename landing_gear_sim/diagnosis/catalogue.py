@@ -173,11 +173,13 @@ def relaxation_evidence(runs: Sequence[ClassifiedRun], params: RigParameters) ->
     RELAXATION_STD_M (the force hardly moves: a campaign of constant-pressure stops read a
     60 cm relaxation as 50 ± 30 cm), it is fitted."""
     found = relaxation_read(runs, params)
-    if found is None or (found.value > 0.0 and found.t >= RELAXATION_Z) \
-            or abs(found.value) > RELAXATION_STD_M * found.t:  # its σ above RELAXATION_STD_M
+    if found is None:
         return ""
+    length_m, t = found
+    if (length_m > 0.0 and t >= RELAXATION_Z) or abs(length_m) > RELAXATION_STD_M * t:
+        return ""  # read, or read no better than RELAXATION_STD_M (its σ is |length| / t)
     return (f"the tyre's force does not lag its curve as a relaxing tyre's does (it reads a "
-            f"relaxation length of {100 * found.value:+.1f} cm at {found.t:.1f} σ)")
+            f"relaxation length of {100 * length_m:+.1f} cm at {t:.1f} σ)")
 
 
 ACTUATOR = (K.ACTUATOR_NATURAL_FREQUENCY_HZ, K.ACTUATOR_DAMPING_RATIO)

@@ -40,10 +40,9 @@ from landing_gear_sim.diagnosis.library import (
 from landing_gear_sim.diagnosis.relations import Check, Checking, Reads, Relation
 from landing_gear_sim.diagnosis.selection import (
     Rows,
-    Selected,
     Term,
     basis_terms,
-    fit_terms,
+    ordinary_fit,
     term_columns,
 )
 from landing_gear_sim.diagnosis.terms import Shaped
@@ -226,16 +225,23 @@ RELAXATION = Term(K.TYRE_RELAXATION_LENGTH_M, "·lag", "m", math.inf, values=_la
 """The relaxation length σ as a term of the tyre's error (its variable −Ḟ_x / (v_h F_z))."""
 
 
-def relaxation_read(runs: Sequence[ClassifiedRun], params: RigParameters) -> Selected | None:
-    """The relaxation length the tyre's error over the curve's samples reads under
-    ``params`` (a model whose tyre does not relax): that error regressed on the lag alone,
-    beside the curve's derivatives (the calibration may bend it), with its t (None: no
-    samples). The project's generator's 3, 8 and 20 cm read 2.8-3.0, 7.7-7.9 and 19.6-19.7
-    cm, at t 2.4-21."""
+def relaxation_read(runs: Sequence[ClassifiedRun], params: RigParameters
+                    ) -> tuple[float, float] | None:
+    """The relaxation length [m] the tyre's error over the curve's samples reads under
+    ``params`` (a model whose tyre does not relax), and its t: that error regressed on the
+    lag alone, beside the curve's derivatives (the calibration may bend it); None: no
+    samples. An ordinary fit: one term needs no sparse solver (whose library, loaded here,
+    the fits' processes forked after it had each carried: 50 MB more at their peak). The
+    project's generator's 3, 8 and 20 cm read 2.8-3.0, 7.7-7.9 and 19.6-19.7 cm, at t
+    2.4-21."""
     rows = [r for run in runs if run.braking
             and (r := TYRE.rows(br.prepare(run, params), params, [RELAXATION])) is not None]
-    fitted = fit_terms([RELAXATION], rows) if rows else None
-    return fitted.selected[0] if fitted and fitted.selected else None
+    if not rows:
+        return None
+    coef, t = ordinary_fit(np.hstack([np.vstack([r.terms for r in rows]),
+                                      np.vstack([r.owned for r in rows])]),
+                           np.concatenate([r.error for r in rows]))
+    return float(coef[0]), float(t[0])
 
 
 DECLARED = Declared(f"{LAW} (tyre force)", "wheel_speed_rad_s", (

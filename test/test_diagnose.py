@@ -586,8 +586,11 @@ def test_a_signal_to_diagnose_ends_its_workers_and_writes_nothing(reference, tmp
         lines.append(line)
         if "round 1: fitting" in line:
             break
-    time.sleep(2.0)  # the workers are fitting
-    workers = _children(process.pid)
+    # the signal while the workers fit: as soon as both are there (a round without a fade or
+    # a relaxation to fit can end within 2 s, and a signal after it tests another phase)
+    deadline = time.monotonic() + 10
+    while len(workers := _children(process.pid)) < 2 and time.monotonic() < deadline:
+        time.sleep(0.02)
     assert len(workers) >= 2, "".join(lines)
     process.send_signal(signum)
     rest = process.communicate(timeout=20)[1]

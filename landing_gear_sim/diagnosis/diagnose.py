@@ -15,7 +15,7 @@
 from __future__ import annotations
 
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -328,16 +328,9 @@ def _testable(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],
               problems: list[str], say: Progress) -> tuple[list[Candidate], list[str]]:
     """The candidates the runs can identify, and the causes of the others that could hide
     in what the runs show; every other noted in ``problems``."""
-    testable, skipped = [], []
-    for candidate in candidates:
-        reason = untestable(candidate, runs)
-        if reason:
-            problems.append(f"{candidate.cause}: {reason}")
-            say(f"{candidate.cause}: skipped, {reason}")
-            skipped.append(candidate.cause)
-        else:
-            testable.append(candidate)
-    return testable, [c for c in skipped if _could_show(CATALOGUE[c], runs)]
+    testable, skipped = _set_aside(candidates, lambda c: untestable(c, runs), "skipped", "",
+                                   problems, say)
+    return testable, [c.cause for c in skipped if _could_show(c, runs)]
 
 
 def _evidenced(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],
@@ -346,15 +339,27 @@ def _evidenced(candidates: Sequence[Candidate], runs: Sequence[ClassifiedRun],
     """The candidates whose sign the runs may show under the ``calibrated`` model; every
     other noted in ``problems`` with what the runs show instead (a fit that cannot pass the
     evidence costs as much as one that can)."""
-    shown = []
-    for candidate in candidates:
-        reason = candidate.evidence(runs, calibrated) if candidate.evidence else ""
-        if reason:
-            problems.append(f"{candidate.cause}: not fitted: {reason}")
-            say(f"{candidate.cause}: not fitted, {reason}")
-        else:
-            shown.append(candidate)
+    shown, _ = _set_aside(candidates,
+                          lambda c: c.evidence(runs, calibrated) if c.evidence else "",
+                          "not fitted", "not fitted: ", problems, say)
     return shown
+
+
+def _set_aside(candidates: Sequence[Candidate], why: Callable[[Candidate], str], said: str,
+               noted: str, problems: list[str], say: Progress
+               ) -> tuple[list[Candidate], list[Candidate]]:
+    """The candidates ``why`` gives no reason against, and the others, each noted in
+    ``problems`` (``noted`` and its reason) and said (``said``, its reason)."""
+    kept, aside = [], []
+    for candidate in candidates:
+        reason = why(candidate)
+        if reason:
+            problems.append(f"{candidate.cause}: {noted}{reason}")
+            say(f"{candidate.cause}: {said}, {reason}")
+            aside.append(candidate)
+        else:
+            kept.append(candidate)
+    return kept, aside
 
 
 def _could_show(candidate: Candidate, runs: Sequence[ClassifiedRun]) -> bool:

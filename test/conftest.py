@@ -3,11 +3,16 @@
 from __future__ import annotations
 
 import os
+import zlib
 
 # Set before anything can import rclpy: Fast DDS would otherwise multicast on the LAN,
-# and parallel test processes would cross-talk on a shared domain.
+# and parallel test processes would cross-talk on a shared domain. One domain per test
+# process: the run's own base, then one step per xdist worker, so the workers of one run
+# never share a domain (each process's pid modulo 100 had, 1 run in 100).
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-os.environ["ROS_DOMAIN_ID"] = str(1 + os.getpid() % 100)
+os.environ["ROS_DOMAIN_ID"] = str(1 + (
+    zlib.crc32(os.environ.get("PYTEST_XDIST_TESTRUNUID", str(os.getpid())).encode()) % 50 * 4
+    + int(os.environ.get("PYTEST_XDIST_WORKER", "gw0").removeprefix("gw"))) % 200)
 
 import pytest
 from graph_support import start  # noqa: F401  # the graph tests' launcher fixture

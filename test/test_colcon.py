@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from graph_support import SHORT
+from graph_support import SHORT, product_lines
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE_FILES = ("package.xml", "setup.py", "setup.cfg", "README.md", "colcon.pkg", "resource",
@@ -102,7 +102,7 @@ install/landing_gear_sim/lib/landing_gear_sim/plant --ros-args -p run.profile:=n
     result = subprocess.run(["bash", "-c", script], cwd=workspace, capture_output=True,
                             text=True, check=False, env=env, timeout=120)
     assert result.returncode == 2, result.stderr
-    assert result.stderr.strip().splitlines() == [
+    assert product_lines(result.stderr) == [
         "plant: error: unknown profile 'nope'; choose from constant, osc-low, osc-high, ramp, "
         "steps, sweep, steps-sweep, file, external"]
 

@@ -13,7 +13,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from graph_support import FIELDS, SHORT, offline_run, rig_command, run_command, wait_for
+from graph_support import (
+    FIELDS,
+    SHORT,
+    offline_run,
+    product_lines,
+    rig_command,
+    run_command,
+    wait_for,
+)
 from rosbags.rosbag2 import Reader
 
 from landing_gear_sim.model.integrate import simulate
@@ -265,7 +273,7 @@ def test_replay_of_a_bad_file_is_one_error_line_and_exit_2(tmp_path):
     for name, (path, fragment) in _bad_files(tmp_path).items():
         done = run_command([sys.executable, "-m", "landing_gear_sim.ros.nodes.replay",
                             "--ros-args", "-p", f"file:={path}"], timeout=60)
-        lines = done.stderr.strip().splitlines()
+        lines = product_lines(done.stderr)
         assert done.returncode == 2, (name, done.stderr)
         assert len(lines) == 1 and str(path) in lines[0] and fragment in lines[0], (name, lines)
 

@@ -31,6 +31,10 @@ _THREADS = os.cpu_count() or 1
 _BUSY: Counter | None = None
 
 
+HELD = frozenset({signal.SIGINT, signal.SIGTERM})
+"""The signals a pool's workers are forked holding (:func:`signals_held`)."""
+
+
 def pool_worker(busy: Counter | None = None) -> None:
     """Initializer of a worker-pool process: dies with its parent, leaves Ctrl-C to it (the
     parent stops the pool), and ends on SIGTERM at once (without the parent's handlers,
@@ -41,7 +45,23 @@ def pool_worker(busy: Counter | None = None) -> None:
     die_with_parent()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD)  # forked under signals_held()
     _THREADS, _BUSY = 1, busy
+
+
+@contextmanager
+def signals_held() -> Iterator[None]:
+    """Hold Ctrl-C and SIGTERM in this thread while it forks a pool's workers (whose
+    initializer is :func:`pool_worker`). A worker signalled between its fork and its
+    initializer ran the parent's handlers, inherited with the fork, and printed their
+    exception's traceback; it inherits the hold instead, and the initializer lets the
+    signal in once the worker's own handlers are in place. Here, a signal that came
+    meanwhile is delivered as the block ends."""
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, HELD)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 def busy_counter() -> Counter:

@@ -793,3 +793,48 @@ def test_a_worker_killed_mid_result_does_not_hang_the_exit():
     stop_pool(pool)
     manager.join(timeout=5)
     assert not manager.is_alive()
+
+
+_LATE_WORKER = """
+import multiprocessing, signal, sys, time
+from concurrent.futures import ProcessPoolExecutor
+from landing_gear_sim.diagnosis.rounds import stop_pool
+from landing_gear_sim.processes import pool_worker, signals_held
+
+class Terminated(BaseException):  # what the CLI's SIGTERM handler raises
+    pass
+
+def terminate(signum, frame):
+    raise Terminated
+
+def late_start():  # the moment between a worker's fork and its initializer, made long
+    time.sleep(1.0)
+    pool_worker()
+
+signal.signal(signal.SIGTERM, terminate)
+with {hold}:
+    pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork"),
+                               initializer=late_start)
+    pool.submit(abs, -1)
+[worker] = multiprocessing.active_children()
+stop_pool(pool)
+worker.join(5)  # past its initializer's second
+print(worker.exitcode)
+"""
+
+
+@pytest.mark.parametrize("hold", ["signals_held()", "contextlib.nullcontext()"])
+def test_a_worker_stopped_before_its_initializer_ran_ends_without_a_traceback(hold):
+    """A pool's worker runs its parent's handlers until its initializer replaces them: a
+    SIGTERM then (`diagnose` stopping its pool as a signal struck) raised the CLI's exception
+    in the worker, which printed its traceback. Forked holding the signals, it ends quietly
+    by SIGTERM; forked without the hold, the same moment prints the traceback."""
+    script = _LATE_WORKER.format(hold=hold).replace("import multiprocessing",
+                                                    "import contextlib, multiprocessing")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=30)
+    assert done.returncode == 0, done.stderr
+    if hold == "signals_held()":
+        assert done.stdout.split() == [str(-signal.SIGTERM)] and not done.stderr, done.stderr
+    else:
+        assert "Traceback" in done.stderr and "Terminated" in done.stderr, done.stderr

@@ -36,7 +36,7 @@ from landing_gear_sim.diagnosis.scoring import (
 from landing_gear_sim.diagnosis.start import FRICTION_CURVE
 from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.processes import busy_counter, pool_worker, working
+from landing_gear_sim.processes import busy_counter, pool_worker, signals_held, working
 
 MAX_ROUNDS = 4
 
@@ -179,10 +179,11 @@ def _score_all(pending: Sequence[Candidate], runs: Sequence[ClassifiedRun], mode
     side = ThreadPoolExecutor(1)
     try:
         # the costliest first (more fitted parameters: more simulations per step), so the
-        # last to finish is a short one
-        futures = {pool.submit(_score_one, c, runs, model, datasheet, scales, signatures,
-                               ended.get(c.cause)): c
-                   for c in sorted(pending, key=lambda c: -len({*c.keys, *c.free}))}
+        # last to finish is a short one; the first submission forks the workers
+        with signals_held():
+            futures = {pool.submit(_score_one, c, runs, model, datasheet, scales, signatures,
+                                   ended.get(c.cause)): c
+                       for c in sorted(pending, key=lambda c: -len({*c.keys, *c.free}))}
         # on a thread only once the workers are forked: a fork while it holds a lock (an
         # import's) would leave the child waiting on it; numpy's error state goes with it
         beside = side.submit(contextvars.copy_context().run, meanwhile)

@@ -124,12 +124,13 @@ def _valley(structure: np.ndarray):
 def _fit(residuals, negligible_score=None):
     """The fits' own optimiser on ``residuals``; with ``negligible_score=0``, stopping at
     FTOL alone."""
+    from landing_gear_sim.calibration import statistics
     from landing_gear_sim.calibration.differences import Objective
     from landing_gear_sim.diagnosis import catalogue
 
     with pytest.MonkeyPatch.context() as patch:
         if negligible_score is not None:
-            patch.setattr(catalogue, "NEGLIGIBLE_SCORE", negligible_score)
+            patch.setattr(statistics, "NEGLIGIBLE_SCORE", negligible_score)
         return catalogue._optimise(Objective(residuals), np.array([0.05, 0.9]),
                                    catalogue.MAX_ITERATIONS)
 

@@ -20,7 +20,12 @@ from landing_gear_sim.calibration.differences import (
 from landing_gear_sim.calibration.measured import simulate_run, simulate_run_with_sensitivities
 from landing_gear_sim.calibration.runs import ClassifiedRun, braking_window
 from landing_gear_sim.calibration.slots import Slot
-from landing_gear_sim.calibration.statistics import Estimate, covariance_std, run_weights
+from landing_gear_sim.calibration.statistics import (
+    Estimate,
+    covariance_std,
+    negligible_gain,
+    run_weights,
+)
 from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import keys as K
@@ -239,7 +244,7 @@ def _least_squares(residuals: Callable[[Sequence[np.ndarray]], list[np.ndarray]]
     (on the plant's own derivatives where differences.MODEL_DERIVATIVES is on)."""
     objective = Objective(residuals, *REFINE_BOUNDS, derivatives=derivatives)
     return least_squares(objective.fun, start, jac=objective.jac, bounds=REFINE_BOUNDS,
-                         max_nfev=iterations)
+                         ftol=negligible_gain(objective.fun(start)), max_nfev=iterations)
 
 
 def _jackknife_std(residuals: Callable[[Sequence[np.ndarray], Sequence[int]],

@@ -30,8 +30,8 @@ from landing_gear_sim.calibration.runs import (
 )
 from landing_gear_sim.calibration.statistics import (
     covariance_std,
-    effective_count,
     input_timing_std_s,
+    negligible_gain,
 )
 from landing_gear_sim.diagnosis.equations.tyre import relaxation_read
 from landing_gear_sim.diagnosis.local import campaign_gain
@@ -50,15 +50,6 @@ from msg_tools.units import PA_PER_BAR
 START_RATIO = 2.0  # multi-start: optimise only starts this close to the best initial cost
 PROBE_ITERATIONS = 3  # multi-start: each start gets this many steps, then only the best goes on
 MAX_ITERATIONS = 40  # the budget of one optimisation, in evaluations (each Jacobian adds n more)
-# a fit stops when a step lowers the cost by less than this fraction: costs are ~1e4-1e5
-# (noise-scaled squares), so that is < 0.5 in χ², far below the ΔBIC threshold of 10
-# (scipy's default, 1e-8, went on for twice the steps to gain < 1)
-FTOL = 1e-5
-# nor once a step moves n_eff·ln(RSS), the unit of ΔBIC and of the held-out score, by less
-# than this: where the residual is mostly structure (few effective samples: a fade tried
-# before the valve's delay is in, at a cost of 3e6) FTOL alone let a fit crawl along a
-# valley, 18 of its 34 steps for 0.3 % of its cost (0.4 in that unit)
-NEGLIGIBLE_SCORE = 0.1
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -467,9 +458,9 @@ def _fitted(candidate: Candidate, problem: _Problem, best: OptimizeResult,
 
 def _optimise(objective: Objective, start: np.ndarray, iterations: int) -> OptimizeResult:
     """Least squares on the unit box from ``start``, at most ``iterations`` steps."""
-    ftol = max(FTOL, NEGLIGIBLE_SCORE / effective_count(objective.fun(start)))
     return least_squares(objective.fun, start, jac=objective.jac, bounds=(0.0, 1.0),
-                         x_scale=0.01, ftol=ftol, max_nfev=iterations)
+                         x_scale=0.01, ftol=negligible_gain(objective.fun(start)),
+                         max_nfev=iterations)
 
 
 @dataclass(frozen=True)

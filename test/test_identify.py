@@ -10,6 +10,7 @@ import shutil
 import numpy as np
 import pytest
 
+from landing_gear_sim.calibration import friction, statistics
 from landing_gear_sim.calibration import runs as runs_module
 from landing_gear_sim.calibration.braking import prepare
 from landing_gear_sim.calibration.campaign import (
@@ -507,3 +508,27 @@ def test_a_model_with_a_valve_delay_the_rig_lacks_fails_the_pressure_channel(
     assert sentence.startswith("Fail: the model misses the brake pressure on ")
     assert "actuator_steps_sweep" in pressure.failed  # the valve's steps show a delay most
     assert "bar" in sentence and "vertical load" in sentence.split(". It matches")[1]
+
+
+def test_the_friction_refinement_stops_once_its_steps_no_longer_move_the_score(monkeypatch):
+    """campaign_v1's refinement went on to its budget of 12 evaluations for 1e-5 of its cost
+    (2.0 s of a 7.5 s diagnosis), along a floor its runs hardly tilt. Like a candidate's fit,
+    it stops once a step gains less than a tenth in n_eff·ln(RSS), and what it leaves lies
+    under any threshold of that unit."""
+    noise = np.random.default_rng(3).normal(0.0, 1.0, 4000)
+
+    def residuals(points):  # a wheel speed's noise beside a curved valley in ϑ1, ϑ2
+        return [np.concatenate([noise, [10.0 * (u[1] - u[0] ** 2), 1.5 - u[0], u[2] - 1.0]])
+                for u in points]
+
+    def fit():
+        return friction._least_squares(residuals, lambda u: None, np.ones(3),
+                                       friction.REFINE_ITERATIONS)
+
+    ours = fit()
+    monkeypatch.setattr(statistics, "NEGLIGIBLE_SCORE", 0.0)
+    monkeypatch.setattr(statistics, "FTOL", 1e-8)  # scipy's default, as before
+    crawl = fit()
+    n_eff = statistics.effective_count(residuals([crawl.x])[0])
+    assert crawl.nfev == friction.REFINE_ITERATIONS and ours.nfev < crawl.nfev / 2
+    assert n_eff * np.log(ours.cost / crawl.cost) < 0.5

@@ -393,3 +393,49 @@ def test_a_discovered_law_reads_its_coefficients_once_in_engineering_units(refer
                               baseline={}, start=reference, calibrated=reference,
                               extended=reference, signatures_before=[], signatures_after=[]))
     assert "(P·ΔP ± 1.2 %, P·Ṗ ± 2.2 %)" in said and "e-07" not in said, said
+
+
+def _overlapping(a, b) -> bool:
+    return a.x0 < b.x1 and b.x0 < a.x1 and a.y0 < b.y1 and b.y0 < a.y1
+
+
+def _laid_out_within(fig) -> list[str]:
+    """What of ``fig``, drawn, leaves the figure or runs into another part of it."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    page = fig.bbox.padded(-1.0)
+    parts = [(f"axes {i}", axis.get_tightbbox(renderer)) for i, axis in enumerate(fig.axes)]
+    parts += [("title", fig._suptitle.get_window_extent(renderer))] if fig._suptitle else []
+    parts += [("legend", legend.get_window_extent(renderer)) for legend in fig.legends]
+    faults = [f"{name} leaves the figure" for name, box in parts
+              if not (page.x0 <= box.x0 and box.x1 <= page.x1 and page.y0 <= box.y0
+                      and box.y1 <= page.y1)]
+    return faults + [f"{a} runs into {b}" for i, (a, one) in enumerate(parts)
+                     for b, other in parts[i + 1:] if _overlapping(one, other)]
+
+
+@pytest.mark.parametrize("channels", [("pressure_pa",), ("pressure_pa", "wheel_speed_rad_s",
+                                                         "longitudinal_force_n")])
+def test_figures_laid_out_by_fixed_margins_keep_every_label_inside_and_apart(
+        reference, tmp_path, monkeypatch, channels):
+    """The page's run figures and spectra are laid out by margins in inches, not by a layout
+    engine (a third of a diagnosis page's time): at one channel and at three, no label, title
+    or legend leaves the figure or runs into another axis' labels."""
+    import numpy as np
+
+    from landing_gear_sim.calibration.validate import compare
+    from landing_gear_sim.diagnosis.residuals import spectrum
+    from landing_gear_sim.model import scenario as sc
+    from landing_gear_sim.model.integrate import simulate
+    from landing_gear_sim.report import diagnosis, validation
+
+    run = simulate(reference, sc.constant_pressure_test(reference, 45e5)).to_run(1)
+    saved = _figures_saved(monkeypatch, validation, diagnosis)
+    diagnosis.plot_before_after(run, run, run, channels, tmp_path / "b.png")
+    comparison = compare(run, run)
+    validation.plot_overlay(dataclasses.replace(comparison, scores={c: comparison.scores[c]
+                                                        for c in channels}), tmp_path / "c.png")
+    noise = np.random.default_rng(5).normal(0.0, 1.5e-5, 20_000)  # the smallest PSD's labels
+    diagnosis.plot_spectrum(spectrum(noise, 1000.0), "run", channels[-1], tmp_path / "p.png")
+    assert len(saved) == 3
+    assert [_laid_out_within(fig) for fig in saved] == [[], [], []]

@@ -25,7 +25,7 @@ from landing_gear_sim.diagnosis.residuals import Spectrum
 from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, HELD_OUT_THRESHOLD
 from landing_gear_sim.model.datasheet import UNITS, datasheet_values
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.report.figures import DISPLAY_UNITS, save_figure
+from landing_gear_sim.report.figures import DISPLAY_UNITS, fixed_margins, save_figure
 from landing_gear_sim.report.first_screen import first_figure
 from landing_gear_sim.report.local import local_gain_section
 from landing_gear_sim.report.pages import html_image, html_table, text_table, write_html
@@ -49,7 +49,7 @@ def plot_before_after(measured: Run, before: Run, after: Run, channels: Sequence
     """Measured (black), starting model (blue) and extended model (red), and the two
     residuals, per channel."""
     fig, axes = plt.subplots(2 * len(channels), 1, figsize=(9, 3.2 * len(channels) + 0.6),
-                             sharex=True, squeeze=False, layout="constrained")
+                             sharex=True, squeeze=False)
     t = measured.time_s - measured.time_s[0]
     for i, channel in enumerate(channels):
         factor, unit = DISPLAY_UNITS[channel]
@@ -69,6 +69,7 @@ def plot_before_after(measured: Run, before: Run, after: Run, channels: Sequence
                fontsize=8)  # off the traces (it had covered brake_osc_low's pressure)
     axes[-1, 0].set_xlabel(f"time in {measured.name} [s]")
     fig.suptitle(f"{measured.name}: measured, starting and extended model")
+    fixed_margins(fig)
     return save_figure(fig, path)
 
 
@@ -95,7 +96,7 @@ def plot_spectrum(spectrum: Spectrum, title: str, channel: str, path: Path) -> P
     axis.set_title(title, fontsize=10)
     axis.grid(alpha=0.3, which="both")
     axis.legend(fontsize=8)
-    fig.tight_layout()
+    fixed_margins(fig, left_in=1.1, bottom_in=0.55, top_in=0.35)
     return save_figure(fig, path)
 
 

@@ -26,7 +26,7 @@ from landing_gear_sim.calibration.validate import (
 )
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import friction_at, friction_coefficients
-from landing_gear_sim.report.figures import DISPLAY_UNITS, save_figure
+from landing_gear_sim.report.figures import DISPLAY_UNITS, fixed_margins, save_figure
 from landing_gear_sim.report.pages import html_image, html_table, write_html
 
 
@@ -36,7 +36,7 @@ def plot_overlay(comparison: RunComparison, path: Path) -> Path:
     residual shows the difference (issue 32)."""
     channels = list(comparison.scores)
     fig, axes = plt.subplots(2 * len(channels), 1, figsize=(9, 3.0 * len(channels) + 0.8),
-                             sharex=True, squeeze=False, layout="constrained",
+                             sharex=True, squeeze=False,
                              gridspec_kw={"height_ratios": [2, 1] * len(channels)})
     m, s = comparison.measured, comparison.simulated
     n = min(len(m), len(s))
@@ -59,6 +59,7 @@ def plot_overlay(comparison: RunComparison, path: Path) -> Path:
                fontsize=8, frameon=False)
     axes[-1, 0].set_xlabel(f"time in {m.name} [s]")
     fig.suptitle(f"{m.name} ({comparison.kind}): measured and simulated", fontsize=11)
+    fixed_margins(fig, top_in=0.65, gap_in=0.35)  # room for each channel's fit above its axes
     return save_figure(fig, path)
 
 

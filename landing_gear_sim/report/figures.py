@@ -37,7 +37,8 @@ def fixed_margins(fig: plt.Figure, *, left_in: float = 0.95, right_in: float = 0
     every tick label in a draw of its own before the real one: a third of a diagnosis
     page's time went to it (8 runs, each with its spectrum)."""
     width, height = fig.get_size_inches()
-    rows = fig.axes[0].get_gridspec().nrows
+    grid = fig.axes[0].get_gridspec()
+    rows = grid.nrows if grid is not None else 1
     bottom, top = bottom_in / height, 1.0 - top_in / height
     row_in = ((top - bottom) * height - (rows - 1) * gap_in) / rows
     fig.subplots_adjust(left=left_in / width, right=1.0 - right_in / width, bottom=bottom,

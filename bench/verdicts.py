@@ -6,7 +6,9 @@ Run: ``python bench/verdicts.py --save out/verdicts/before.json`` on the code be
 campaign's answer is its verdict and, per finding, its cause (family, equation) and key
 parameters with their σ. After a step every verdict and every finding's cause must be the
 same, and each parameter must lie within its σ of the kept value (the larger of the two
-σ); the command lists every difference and exits 1 when there is one.
+σ); the command lists every difference and exits 1 when there is one. It answers for the
+checkout it stands in, and refuses to run on another's code: from a worktree, run it with
+``PYTHONPATH`` set to the worktree.
 
 The campaigns (``--sets``, default all):
 
@@ -45,6 +47,12 @@ from msg_tools.io import read_runs
 
 SETS = ("independent", "unseen", "bench", "outside")
 Answer = dict[str, object]
+CHECKOUT = Path(__file__).resolve().parents[1]
+
+
+def imported_from() -> Path:
+    """The checkout whose ``landing_gear_sim`` this process runs."""
+    return Path(diagnose.__code__.co_filename).resolve().parents[2]
 
 
 @dataclass(frozen=True)
@@ -174,6 +182,11 @@ def main() -> int:
     unknown = set(args.sets.split(",")) - set(SETS)
     if unknown:
         parser.error(f"--sets: unknown {', '.join(sorted(unknown))}")
+    if imported_from() != CHECKOUT:
+        # run from a worktree, a script's path is its bench/ folder and the editable install
+        # gives the main checkout's code: the guard would answer for another change
+        parser.error(f"the diagnosis imported is {imported_from()}'s, not this checkout's "
+                     f"({CHECKOUT}): run it with PYTHONPATH={CHECKOUT}")
     kept = json.loads(args.against.read_text(encoding="utf-8")) if args.against else {}
     output = args.save or args.output or args.against.with_suffix(".after.json")
     done = json.loads(output.read_text(encoding="utf-8")) if output.is_file() else {}

@@ -7,12 +7,13 @@ one with an actuator delay, starting models without an element, and a partial ca
 (braking runs only); the example campaigns too when ``../shared/data`` is present. Each
 diagnosis runs in a fresh interpreter of the checkout measured (compiled code loaded from
 its cache, its first call excluded). "passes" is the diagnosis's time over one plain
-simulation pass of the campaign (every run re-simulated with its measured input) in that
-same interpreter: a ratio that holds from machine to machine. With ``--against`` (the code
-before, a ``git worktree``) each campaign is diagnosed by both, one after the other, and
-"faster" is the time before over the time now. "sim" counts the runs the diagnosis
-simulated (in this process and its fits' processes), in whole-campaign passes; "again" how
-many of those a parameter set had simulated already (issue 61: each (parameters, run) once).
+simulation pass of the campaign (every run re-simulated with its measured input; the median
+of three) in that same interpreter: a ratio that holds from machine to machine. With
+``--against`` (the code before, a ``git worktree``) each campaign is diagnosed by both, one
+after the other, and "faster" is the time before over the time now. "sim" counts the runs
+the diagnosis simulated (in this process and its fits' processes), in whole-campaign
+passes; "again" how many of those a parameter set had simulated already (issue 61: each
+(parameters, run) once).
 
 Targets (issue 61, a quiet 2-core machine): campaign_v1 ≤ 30 passes, every campaign ≤ 50,
 peak memory no higher than before; the verdicts the same.
@@ -69,9 +70,13 @@ try:  # the dual kernels loaded before the clock starts, where the fits use them
         prepare_kernels(base)
 except ImportError:
     pass
-start = time.perf_counter()
-simulate_all(runs, base)
-one_pass = time.perf_counter() - start
+# the median of three passes: one alone varied by 10 % from run to run, and the ratio with it
+passes = []
+for _ in range(3):
+    start = time.perf_counter()
+    simulate_all(runs, base)
+    passes.append(time.perf_counter() - start)
+one_pass = sorted(passes)[1]
 # every simulation of a run with a parameter set, in this process and the forked fits':
 # a line each, (parameters, run) hashed, appended to one file (O_APPEND: whole lines)
 log = os.path.join(tempfile.mkdtemp(), "simulated")
@@ -91,7 +96,8 @@ keys = Path(log).read_text().split()
 own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 worker = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
 found = {k: v for f in result.findings[:1] for k, v in f.parameters.items()}
-print(json.dumps({"verdict": result.verdict, "seconds": elapsed, "pass_s": one_pass,
+print(json.dumps({"checkout": str(Path(diagnose.__code__.co_filename).resolve().parents[2]),
+                  "verdict": result.verdict, "seconds": elapsed, "pass_s": one_pass,
                   "peak_mb": own + 2 * worker, "found": found, "runs": len(runs),
                   "simulated": len(keys), "distinct": len(set(keys))}))
 """
@@ -104,7 +110,13 @@ def _measure(checkout: Path, folder: Path, without: tuple[str, ...]) -> dict:
     done = subprocess.run([sys.executable, "-c", MEASURE, str(folder), ",".join(without)],
                           env=env, check=True, capture_output=True, text=True,
                           cwd=tempfile.gettempdir())
-    return json.loads(done.stdout.strip().splitlines()[-1])
+    measured = json.loads(done.stdout.strip().splitlines()[-1])
+    if Path(measured["checkout"]) != checkout.resolve():
+        # PYTHONPATH names no checkout (a worktree not made, a typo): the editable install
+        # gave the main checkout's code, and "before" had measured the code now
+        raise SystemExit(f"bench/diagnose.py: error: {checkout} is not a checkout of the "
+                         f"package: the diagnosis measured was {measured['checkout']}'s")
+    return measured
 
 
 def _row(name: str, folder: Path, without: tuple[str, ...], before: Path | None) -> None:
@@ -134,6 +146,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--against", type=Path, help="the code before (a checkout)")
     args = parser.parse_args()
+    if args.against and not (args.against / "landing_gear_sim" / "__init__.py").is_file():
+        parser.error(f"--against: {args.against} is not a checkout of the package")
     print("diagnose on full campaigns: time, passes (time over one simulation pass) and "
           "the passes' ratio to the target (> 1 beats it), peak memory, the runs simulated "
           "(in whole-campaign passes) and how many of them again with the same parameters"

@@ -30,3 +30,12 @@ def test_the_verdict_guard_refuses_to_answer_for_another_checkouts_code(tmp_path
     assert f"PYTHONPATH={elsewhere.parent}" in refused.stderr
     own = _guard(ROOT / "bench", tmp_path / "answers.json")
     assert own.returncode == 0, own.stderr
+
+
+def test_the_diagnosis_bench_refuses_code_before_that_is_no_checkout(tmp_path):
+    """`--against` a folder that holds no checkout (a worktree not made) had measured the
+    code now twice, through the editable install, and printed it as "before"."""
+    done = subprocess.run([sys.executable, str(ROOT / "bench" / "diagnose.py"), "--against",
+                           str(tmp_path)], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2, done.stderr
+    assert f"{tmp_path} is not a checkout of the package" in done.stderr

@@ -796,7 +796,7 @@ def test_a_worker_killed_mid_result_does_not_hang_the_exit():
 
 
 _LATE_WORKER = """
-import multiprocessing, signal, sys, time
+import contextlib, multiprocessing, signal, time
 from concurrent.futures import ProcessPoolExecutor
 from landing_gear_sim.diagnosis.rounds import stop_pool
 from landing_gear_sim.processes import pool_worker, signals_held
@@ -829,10 +829,8 @@ def test_a_worker_stopped_before_its_initializer_ran_ends_without_a_traceback(ho
     SIGTERM then (`diagnose` stopping its pool as a signal struck) raised the CLI's exception
     in the worker, which printed its traceback. Forked holding the signals, it ends quietly
     by SIGTERM; forked without the hold, the same moment prints the traceback."""
-    script = _LATE_WORKER.format(hold=hold).replace("import multiprocessing",
-                                                    "import contextlib, multiprocessing")
-    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                          timeout=30)
+    done = subprocess.run([sys.executable, "-c", _LATE_WORKER.format(hold=hold)],
+                          capture_output=True, text=True, timeout=30)
     assert done.returncode == 0, done.stderr
     if hold == "signals_held()":
         assert done.stdout.split() == [str(-signal.SIGTERM)] and not done.stderr, done.stderr

@@ -24,8 +24,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from landing_gear_sim.calibration import measured
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
-from landing_gear_sim.calibration.measured import CHANNELS, channel_words
+from landing_gear_sim.calibration.measured import CHANNELS, Simulations, channel_words
 from landing_gear_sim.cli import main
 from landing_gear_sim.diagnosis.catalogue import CATALOGUE, gear_walk_key_parameters
 from landing_gear_sim.diagnosis.consistency import inconsistent
@@ -836,3 +837,17 @@ def test_a_worker_stopped_before_its_initializer_ran_ends_without_a_traceback(ho
         assert done.stdout.split() == [str(-signal.SIGTERM)] and not done.stderr, done.stderr
     else:
         assert "Traceback" in done.stderr and "Terminated" in done.stderr, done.stderr
+
+
+def test_a_model_read_twice_is_simulated_once_and_another_set_again(reference, monkeypatch):
+    """The extension and the verdict read the search's model: one pass of the campaign, not
+    two. By identity: a set of the same values made apart is another model's simulation."""
+    simulated: list[object] = []
+    monkeypatch.setattr(measured, "simulate_all",
+                        lambda runs, params: simulated.append(params) or [params])
+    simulations = Simulations([])
+    model = reference.replace({"brake.gain_n_m_per_pa": 0.02}, "a model")
+    assert simulations.of(model) is simulations.of(model)
+    again = reference.replace({"brake.gain_n_m_per_pa": 0.02}, "a model")
+    assert simulations.of(again) == [again]
+    assert simulated == [model, again]

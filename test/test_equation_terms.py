@@ -12,6 +12,7 @@ import pytest
 from landing_gear_sim.calibration import braking as br
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.calibration.identify import identify
+from landing_gear_sim.calibration.measured import Simulations
 from landing_gear_sim.calibration.runs import classify_all
 from landing_gear_sim.diagnosis.diagnose import diagnose
 from landing_gear_sim.diagnosis.equations import Equation
@@ -296,7 +297,7 @@ def test_of_two_causes_beside_a_discovered_term_only_the_one_it_replaces_goes(re
                                   "actuator.delay_s": 0.005}, "both causes")
     causes = [scored("tire_relaxation", extended), scored("actuator_delay", extended)]
     said: list[str] = []
-    story = Story([], reference, reference, {}, [], [], said.append)
+    story = Story([], reference, reference, {}, [], [], said.append, Simulations([]))
     monkeypatch.setattr(Story, "_earns", lambda self, cause, model: cause is causes[1])
     extension = story._beside([], causes, Discovery(scored("discovered", extended)),
                               Discovery(None))

@@ -269,3 +269,22 @@ def simulate_all(runs: Sequence[Run], params: RigParameters) -> list[Run]:
     """Every run simulated with its measured input, on its own time base (the runs side by
     side: the compiled simulation releases the GIL)."""
     return list(map_threads(lambda run: simulate_run(run, params)[0], runs))
+
+
+class Simulations:
+    """The ``runs`` simulated under each model asked for, each model once: by identity, as
+    parameter sets are immutable (the diagnosis's extension read its search's model and the
+    verdict read it again: a pass of the campaign simulated twice)."""
+
+    def __init__(self, runs: Sequence[Run]) -> None:
+        self._runs = runs
+        self._done: list[tuple[RigParameters, list[Run]]] = []
+
+    def of(self, model: RigParameters) -> list[Run]:
+        """The runs simulated under ``model``."""
+        for done, simulated in self._done:
+            if done is model:
+                return simulated
+        simulated = simulate_all(self._runs, model)
+        self._done.append((model, simulated))
+        return simulated

@@ -23,7 +23,7 @@ import numpy as np
 from landing_gear_sim.calibration import differences
 from landing_gear_sim.calibration.actuator import LATE
 from landing_gear_sim.calibration.identify import Identification, Progress, identify
-from landing_gear_sim.calibration.measured import CHANNELS, simulate_all
+from landing_gear_sim.calibration.measured import CHANNELS, Simulations, simulate_all
 from landing_gear_sim.calibration.runs import ClassifiedRun, classify_all, fully_logged
 from landing_gear_sim.calibration.statistics import Estimate
 from landing_gear_sim.diagnosis import discovered, rounds
@@ -158,10 +158,10 @@ def _diagnose(runs: Sequence[Run], base: RigParameters, without: Sequence[str],
     start.problems.extend(unchecked_relations(start.runs, calibrated_checks))
     start.problems.extend(coarse_channels(start.runs, calibrated_checks))
     story = discovered.Story(start.runs, start.calibrated, base, start.scales, start.tried,
-                             calibrated_checks, say)
+                             calibrated_checks, say, Simulations(start.runs))
     model, accepted, checks, extension = _extended(story, search, checks)
     say("analysing the residuals of the extended model")
-    simulated_after = simulate_all(start.runs, model)
+    simulated_after = story.simulations.of(model)
     after = _interpretable(find_signatures(start.runs, model, simulated_after), start.runs)
     verdict, findings = _verdict(start, search.table, accepted, model, checks,
                                  simulated_after, after)

@@ -16,7 +16,12 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 from landing_gear_sim.calibration.identify import Progress
-from landing_gear_sim.calibration.measured import CHANNELS, channels_of, simulate_all
+from landing_gear_sim.calibration.measured import (
+    CHANNELS,
+    Simulations,
+    channels_of,
+    simulate_all,
+)
 from landing_gear_sim.calibration.runs import ClassifiedRun
 from landing_gear_sim.diagnosis.alike import PREDICTS_BETTER, rivals
 from landing_gear_sim.diagnosis.consistency import check_campaign
@@ -166,7 +171,8 @@ class Extension:
 @dataclass(frozen=True)
 class Story:
     """The campaign as the diagnosis reads it: its runs, the calibrated starting model with
-    its residual ``signatures`` and relation ``checks``, and what scoring needs."""
+    its residual ``signatures`` and relation ``checks``, what scoring needs, and the runs'
+    ``simulations`` under the models the diagnosis reads them under."""
 
     runs: Sequence[ClassifiedRun]
     calibrated: RigParameters
@@ -175,6 +181,7 @@ class Story:
     signatures: Sequence[Signature]
     checks: Sequence[Check]
     say: Progress
+    simulations: Simulations
 
     def extend(self, accepted: list[Scored], model: RigParameters, checks: Sequence[Check]
                ) -> Extension | None:
@@ -191,7 +198,7 @@ class Story:
             term = alone.scored
             return None if term is None else Extension(
                 [term], [], term if term.finding.accepted else None, alone.rivals)
-        signatures = find_signatures(self.runs, model, simulate_all(self.runs, model),
+        signatures = find_signatures(self.runs, model, self.simulations.of(model),
                                      tentative=True)
         if not violations(checks) and not wheel_lags(signatures):
             return None

@@ -53,6 +53,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/graph.py
 	$(BIN)/python bench/controllers.py
 	$(BIN)/python bench/diagnose.py
+	$(BIN)/python bench/report.py
 	$(BIN)/python bench/sensitivity.py
 	$(BIN)/python bench/jacobians.py
 	$(BIN)/python bench/io.py

@@ -1,6 +1,6 @@
 """Child processes that never outlive their parent (Linux), and worker-pool processes that
 leave signals to their parent. Imports nothing of the project:
-the graph launcher and the diagnosis' worker pool both use it."""
+the graph launcher, the diagnosis' worker pool and the report's drawing all use it."""
 
 from __future__ import annotations
 
@@ -8,8 +8,9 @@ import ctypes
 import multiprocessing
 import os
 import signal
+import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from contextlib import AbstractContextManager, contextmanager
 from typing import Any, TypeVar
 
@@ -102,6 +103,69 @@ def map_threads(function: Callable[[Item], Result], items: Iterable[Item]) -> Se
         return [function(item) for item in work]
     with ThreadPoolExecutor(min(cores, len(work))) as pool:
         return list(pool.map(function, work))
+
+
+STOP_WAIT_S = 1.0  # for a pool's terminated workers to end (they take milliseconds)
+
+
+def stop_pool(pool: ProcessPoolExecutor) -> None:
+    """End ``pool``'s workers at once, whatever they are doing, and its manager thread with
+    them. A worker terminated while it sends a result leaves half a message in the result
+    pipe: the manager thread waits for the rest for ever, and the interpreter's exit joins
+    it (a SIGTERM'd ``diagnose`` was found alive 25 minutes on). With this process's copy
+    of the pipe's writer closed, the workers' gone with them, that read ends: the manager
+    finds the pool broken and ends."""
+    # the executor keeps its result pipe private (and drops it on shutdown); only its
+    # workers write to it
+    writer = getattr(getattr(pool, "_result_queue", None), "_writer", None)
+    for child in multiprocessing.active_children():
+        child.terminate()
+    deadline = time.monotonic() + STOP_WAIT_S
+    for child in multiprocessing.active_children():
+        # a join returns as the child's sentinel closes, which can be just before the
+        # kernel lets it be reaped: it had still read as running a moment after
+        while child.exitcode is None and (left := deadline - time.monotonic()) > 0.0:
+            child.join(timeout=left)
+    pool.shutdown(wait=False, cancel_futures=True)
+    if writer is not None:
+        writer.close()
+
+
+Call = tuple[Callable[..., Result], tuple[Any, ...]]
+"""A function defined at a module's top level and its arguments."""
+
+_CALLS: Sequence[Call[Any]] = ()
+
+
+def _call(index: int) -> Any:
+    function, arguments = _CALLS[index]
+    return function(*arguments)
+
+
+def map_forked(calls: Sequence[Call[Result]]) -> list[Result]:
+    """Each call's result, in order, made on a forked process per core: for work that holds
+    the GIL (matplotlib's drawing). The workers inherit the calls with the fork: their
+    arguments are never pickled, only the results. In this process where there is one
+    core, one call, or no room for children (a daemonic process: a Dask worker's). Ctrl-C
+    or SIGTERM ends the workers at once (:func:`stop_pool`)."""
+    global _CALLS
+    workers = min(len(calls), os.cpu_count() or 1)
+    if workers < 2 or multiprocessing.current_process().daemon:
+        return [function(*arguments) for function, arguments in calls]
+    _CALLS = calls
+    pool = ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
+                               initializer=pool_worker)
+    try:
+        with signals_held():
+            futures = [pool.submit(_call, i) for i in range(len(calls))]
+        results = [future.result() for future in futures]
+    except BaseException:
+        stop_pool(pool)
+        raise
+    finally:
+        _CALLS = ()
+    pool.shutdown()
+    return results
 
 
 def single_threaded_blas() -> AbstractContextManager[object]:

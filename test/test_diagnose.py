@@ -33,10 +33,11 @@ from landing_gear_sim.diagnosis.consistency import inconsistent
 from landing_gear_sim.diagnosis.diagnose import Diagnosis, diagnose
 from landing_gear_sim.diagnosis.findings import Finding
 from landing_gear_sim.diagnosis.relations import Check, Relation
-from landing_gear_sim.diagnosis.rounds import stop_pool, tried_again
+from landing_gear_sim.diagnosis.rounds import tried_again
 from landing_gear_sim.diagnosis.scoring import split_runs
 from landing_gear_sim.errors import DiagnosisError
 from landing_gear_sim.model.parameters import load_parameters
+from landing_gear_sim.processes import stop_pool
 from landing_gear_sim.report.words import headline, parameter_text
 from msg_tools.csv_io import read_csv, write_csv
 from msg_tools.io import read_campaign
@@ -799,8 +800,7 @@ def test_a_worker_killed_mid_result_does_not_hang_the_exit():
 _LATE_WORKER = """
 import contextlib, multiprocessing, signal, time
 from concurrent.futures import ProcessPoolExecutor
-from landing_gear_sim.diagnosis.rounds import stop_pool
-from landing_gear_sim.processes import pool_worker, signals_held
+from landing_gear_sim.processes import pool_worker, signals_held, stop_pool
 
 class Terminated(BaseException):  # what the CLI's SIGTERM handler raises
     pass

@@ -36,7 +36,13 @@ from landing_gear_sim.diagnosis.scoring import (
 from landing_gear_sim.diagnosis.start import FRICTION_CURVE
 from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.processes import busy_counter, pool_worker, signals_held, working
+from landing_gear_sim.processes import (
+    busy_counter,
+    pool_worker,
+    signals_held,
+    stop_pool,
+    working,
+)
 
 MAX_ROUNDS = 4
 
@@ -201,25 +207,6 @@ def _score_all(pending: Sequence[Candidate], runs: Sequence[ClassifiedRun], mode
     pool.shutdown()
     side.shutdown()
     return results
-
-
-def stop_pool(pool: ProcessPoolExecutor) -> None:
-    """End ``pool``'s workers at once, whatever they are doing, and its manager thread with
-    them. A worker terminated while it sends a result leaves half a message in the result
-    pipe: the manager thread waits for the rest for ever, and the interpreter's exit joins
-    it (a SIGTERM'd ``diagnose`` was found alive 25 minutes on). With this process's copy
-    of the pipe's writer closed, the workers' gone with them, that read ends: the manager
-    finds the pool broken and ends."""
-    # the executor keeps its result pipe private (and drops it on shutdown); only its
-    # workers write to it
-    writer = getattr(getattr(pool, "_result_queue", None), "_writer", None)
-    for child in multiprocessing.active_children():
-        child.terminate()
-    for child in multiprocessing.active_children():
-        child.join(timeout=1.0)
-    pool.shutdown(wait=False, cancel_futures=True)
-    if writer is not None:
-        writer.close()
 
 
 def _recalibrate(runs: Sequence[ClassifiedRun], start: RigParameters, accepted: list[Scored],

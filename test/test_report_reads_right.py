@@ -445,8 +445,6 @@ def test_a_page_drawn_side_by_side_is_the_page_drawn_on_one_core(reference, tmp_
                                                                  monkeypatch):
     """The page's figures are drawn on forked processes (a campaign's took 6.7 s on one
     core): the same files, byte for byte, as drawn one after another."""
-    import os
-
     from landing_gear_sim.calibration.runs import classified
     from landing_gear_sim.diagnosis.diagnose import Diagnosis
     from landing_gear_sim.diagnosis.residuals import spectrum
@@ -464,10 +462,35 @@ def test_a_page_drawn_side_by_side_is_the_page_drawn_on_one_core(reference, tmp_
                        start=reference, calibrated=reference, extended=reference,
                        signatures_before=[], signatures_after=[],
                        evidence=[evidence(20), evidence(30)])
+    pages = _on_one_and_on_two_cores(lambda folder: write_diagnosis_report(result, folder),
+                                     tmp_path, monkeypatch)
+    assert len(pages[1]) == 6 and pages[1] == pages[2]  # the page, 2 runs' overlays, spectra
+
+
+def _on_one_and_on_two_cores(write, tmp_path, monkeypatch) -> dict[int, dict[str, bytes]]:
+    """The files ``write`` writes into a folder, on one core and on two."""
+    import os
+
     pages = {}
     for cores in (1, 2):
         monkeypatch.setattr(os, "cpu_count", lambda cores=cores: cores)
         folder = tmp_path / str(cores)
-        write_diagnosis_report(result, folder)
+        write(folder)
         pages[cores] = {path.name: path.read_bytes() for path in folder.iterdir()}
-    assert len(pages[1]) == 6 and pages[1] == pages[2]  # the page, 2 runs' overlays, spectra
+    return pages
+
+
+def test_a_validation_page_drawn_side_by_side_is_the_one_drawn_on_one_core(reference, tmp_path,
+                                                                           monkeypatch):
+    from landing_gear_sim.calibration.validate import validate_campaign
+    from landing_gear_sim.model import scenario as sc
+    from landing_gear_sim.model.integrate import simulate
+    from landing_gear_sim.report.validation import write_validation_report
+
+    runs = [simulate(reference, sc.constant_pressure_test(reference, bar * 1e5)).to_run(1)
+            for bar in (20, 30)]
+    validation = validate_campaign(runs, reference)
+    pages = _on_one_and_on_two_cores(
+        lambda folder: write_validation_report(validation, folder, "validation"), tmp_path,
+        monkeypatch)
+    assert len(pages[1]) == 4 and pages[1] == pages[2]  # the page, the curve, 2 overlays

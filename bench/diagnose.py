@@ -16,7 +16,9 @@ passes; "again" how many of those a parameter set had simulated already (issue 6
 (parameters, run) once).
 
 Targets (issue 61, a quiet 2-core machine): campaign_v1 ≤ 30 passes, every campaign ≤ 50,
-peak memory no higher than before; the verdicts the same.
+peak memory no higher than before; the verdicts the same. With ``--busy N`` each campaign is
+diagnosed once more beside N busy loops (processes spinning on a core each) and that time is
+printed over the quiet one: campaign_v1 ≤ 2.5× its quiet time beside two.
 """
 
 from __future__ import annotations
@@ -27,6 +29,8 @@ import os
 import subprocess
 import sys
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -38,6 +42,7 @@ HERE = Path(__file__).resolve().parents[1]
 SHARED = HERE.parent / "shared" / "data"
 TARGET_V1_PASSES = 30
 TARGET_ANY_PASSES = 50
+TARGET_LOADED = 2.5  # campaign_v1 beside two busy loops, over its quiet time
 BRAKING = ("brake_const_10bar", "brake_const_20bar", "brake_const_30bar", "brake_osc_low",
            "brake_osc_high")
 # name: (hidden effect, starting model without, runs (None: all))
@@ -119,7 +124,21 @@ def _measure(checkout: Path, folder: Path, without: tuple[str, ...]) -> dict:
     return measured
 
 
-def _row(name: str, folder: Path, without: tuple[str, ...], before: Path | None) -> None:
+@contextmanager
+def _busy_loops(count: int) -> Iterator[None]:
+    """``count`` processes spinning, a core each, while inside."""
+    loops = [subprocess.Popen([sys.executable, "-c", "while True: pass"])
+             for _ in range(count)]
+    try:
+        yield
+    finally:
+        for loop in loops:
+            loop.kill()
+            loop.wait()
+
+
+def _row(name: str, folder: Path, without: tuple[str, ...], before: Path | None,
+         busy: int = 0) -> None:
     now = _measure(HERE, folder, without)
     passes = now["seconds"] / now["pass_s"]
     target = TARGET_V1_PASSES if name.startswith("campaign_v1") else TARGET_ANY_PASSES
@@ -132,6 +151,11 @@ def _row(name: str, folder: Path, without: tuple[str, ...], before: Path | None)
         text += (f"  | before {then['seconds']:6.1f} s {then['seconds'] / then['pass_s']:5.0f}"
                  f" {then['seconds'] / now['seconds']:5.2f}x {then['peak_mb']:6.0f} MB "
                  f"{_simulated(then)} {same}")
+    if busy:
+        with _busy_loops(busy):
+            loaded = _measure(HERE, folder, without)
+        text += (f"  | beside {busy} busy loops {loaded['seconds']:6.1f} s "
+                 f"{loaded['seconds'] / now['seconds']:5.2f}x quiet")
     print(f"{text}  {found}", flush=True)
 
 
@@ -145,6 +169,9 @@ def _simulated(measured: dict) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--against", type=Path, help="the code before (a checkout)")
+    parser.add_argument("--busy", type=int, default=0, metavar="N",
+                        help=f"diagnose each campaign again beside N busy loops (campaign_v1 "
+                             f"beside 2: ≤ {TARGET_LOADED:g}x its quiet time)")
     args = parser.parse_args()
     if args.against and not (args.against / "landing_gear_sim" / "__init__.py").is_file():
         parser.error(f"--against: {args.against} is not a checkout of the package")
@@ -157,10 +184,10 @@ def main() -> None:
         rig = rig_like(base, np.random.default_rng(500 + i)).replace(effect, "hidden effect")
         with tempfile.TemporaryDirectory() as folder:
             generate_campaign(Path(folder), rig, 500 + i, names)
-            _row(name, Path(folder), without, args.against)
+            _row(name, Path(folder), without, args.against, args.busy)
     for name in ("campaign_v1", "campaign_v2"):
         if (SHARED / name).is_dir():
-            _row(f"{name} (example data)", SHARED / name, (), args.against)
+            _row(f"{name} (example data)", SHARED / name, (), args.against, args.busy)
 
 
 if __name__ == "__main__":

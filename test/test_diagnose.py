@@ -23,6 +23,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from terminal_support import as_from_a_terminal
 
 from landing_gear_sim.calibration import measured
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
@@ -565,13 +566,6 @@ def _alive(pid):
         return False
 
 
-def _as_from_a_terminal() -> None:
-    """Ctrl-C's default, as a terminal starts a command: a suite run as a background job
-    of a script (`.ci/run &`) hands its children SIGINT ignored, and Python keeps a
-    SIGINT it was started ignoring (as `nohup` and `&` mean it to)."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
-
-
 @pytest.mark.parametrize(("signum", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
 def test_a_signal_to_diagnose_ends_its_workers_and_writes_nothing(reference, tmp_path, signum,
                                                                   code):
@@ -582,7 +576,7 @@ def test_a_signal_to_diagnose_ends_its_workers_and_writes_nothing(reference, tmp
     out = tmp_path / "extended.yaml"
     process = subprocess.Popen([sys.executable, "-m", "landing_gear_sim", "diagnose", str(folder),
                                 "-o", str(out)], stderr=subprocess.PIPE, text=True,
-                               preexec_fn=_as_from_a_terminal)
+                               preexec_fn=as_from_a_terminal)
     lines = []
     for line in process.stderr:
         lines.append(line)

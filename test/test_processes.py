@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 
 import pytest
+from terminal_support import as_from_a_terminal
 
 from landing_gear_sim.processes import map_forked
 
@@ -78,7 +79,7 @@ def test_ctrl_c_while_the_workers_draw_ends_them_at_once_without_a_traceback(tmp
     their parent, which ends them rather than wait for their minute of work."""
     process = subprocess.Popen([sys.executable, "-c", _INTERRUPTED, str(tmp_path)],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                               start_new_session=True)
+                               start_new_session=True, preexec_fn=as_from_a_terminal)
     deadline = time.monotonic() + 60
     while len(list(tmp_path.iterdir())) < 2 and time.monotonic() < deadline:
         time.sleep(0.05)

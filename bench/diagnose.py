@@ -29,11 +29,10 @@ import os
 import subprocess
 import sys
 import tempfile
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
+from stopping import busy_loops  # the same load as the stopping bench's
 
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.model.parameters import load_parameters
@@ -124,19 +123,6 @@ def _measure(checkout: Path, folder: Path, without: tuple[str, ...]) -> dict:
     return measured
 
 
-@contextmanager
-def _busy_loops(count: int) -> Iterator[None]:
-    """``count`` processes spinning, a core each, while inside."""
-    loops = [subprocess.Popen([sys.executable, "-c", "while True: pass"])
-             for _ in range(count)]
-    try:
-        yield
-    finally:
-        for loop in loops:
-            loop.kill()
-            loop.wait()
-
-
 def _row(name: str, folder: Path, without: tuple[str, ...], before: Path | None,
          busy: int = 0) -> None:
     now = _measure(HERE, folder, without)
@@ -152,7 +138,7 @@ def _row(name: str, folder: Path, without: tuple[str, ...], before: Path | None,
                  f" {then['seconds'] / now['seconds']:5.2f}x {then['peak_mb']:6.0f} MB "
                  f"{_simulated(then)} {same}")
     if busy:
-        with _busy_loops(busy):
+        with busy_loops(busy):
             loaded = _measure(HERE, folder, without)
         text += (f"  | beside {busy} busy loops {loaded['seconds']:6.1f} s "
                  f"{loaded['seconds'] / now['seconds']:5.2f}x quiet")

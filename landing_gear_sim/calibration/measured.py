@@ -24,7 +24,7 @@ from landing_gear_sim.calibration.wheel_angle import (
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.elements import valve_static_pressure
 from landing_gear_sim.model.integrate import SimulationResult, simulate
-from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.parameters import PerSet, RigParameters
 from landing_gear_sim.model.plant import CHANNELS as PLANT_CHANNELS
 from landing_gear_sim.model.quantities import at_static_load, load_taken_at, rim_speed_m_s
 from landing_gear_sim.model.scenario import Scenario, logged_to_held
@@ -271,20 +271,10 @@ def simulate_all(runs: Sequence[Run], params: RigParameters) -> list[Run]:
     return list(map_threads(lambda run: simulate_run(run, params)[0], runs))
 
 
-class Simulations:
-    """The ``runs`` simulated under each model asked for, each model once: by identity, as
-    parameter sets are immutable (the diagnosis's extension read its search's model and the
-    verdict read it again: a pass of the campaign simulated twice)."""
+class Simulations(PerSet[list[Run]]):
+    """The ``runs`` simulated under each model asked for, each model once (the diagnosis's
+    extension read its search's model and the verdict read it again: a pass of the campaign
+    simulated twice)."""
 
     def __init__(self, runs: Sequence[Run]) -> None:
-        self._runs = runs
-        self._done: list[tuple[RigParameters, list[Run]]] = []
-
-    def of(self, model: RigParameters) -> list[Run]:
-        """The runs simulated under ``model``."""
-        for done, simulated in self._done:
-            if done is model:
-                return simulated
-        simulated = simulate_all(self._runs, model)
-        self._done.append((model, simulated))
-        return simulated
+        super().__init__(lambda model: simulate_all(runs, model))

@@ -35,7 +35,7 @@ from landing_gear_sim.diagnosis.scoring import (
 )
 from landing_gear_sim.diagnosis.start import FRICTION_CURVE
 from landing_gear_sim.errors import IdentificationError
-from landing_gear_sim.model.parameters import RigParameters
+from landing_gear_sim.model.parameters import PerSet, RigParameters
 from landing_gear_sim.processes import (
     busy_counter,
     pool_worker,
@@ -69,24 +69,14 @@ class Search:
     rounds: list[Round] = field(default_factory=list)
 
 
-class Consistency:
+class Consistency(PerSet[list[Check]]):
     """The consistency checks of the models a diagnosis reads them under, each computed
     once (:func:`check_campaign`). A round computes its model's while its candidates fit
     (:meth:`meanwhile`): the calibrated model's are always read, and the last round's model
     is the final one."""
 
     def __init__(self, runs: Sequence[ClassifiedRun]) -> None:
-        self._runs = runs
-        self._done: list[tuple[RigParameters, list[Check]]] = []
-
-    def of(self, model: RigParameters) -> list[Check]:
-        """The checks under ``model``."""
-        for done, checks in self._done:
-            if done is model:
-                return checks
-        checks = check_campaign(self._runs, model)
-        self._done.append((model, checks))
-        return checks
+        super().__init__(lambda model: check_campaign(runs, model))
 
     def meanwhile(self, model: RigParameters) -> Callable[[], object]:
         """A task computing the checks under ``model``, for :func:`_score_all`."""

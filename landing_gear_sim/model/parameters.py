@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import difflib
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 import yaml
 
@@ -443,3 +443,25 @@ def parse_assignment(text: str) -> tuple[str, Value]:
     except yaml.YAMLError:
         value = raw
     return key.strip(), value
+
+
+Computed = TypeVar("Computed")
+
+
+class PerSet(Generic[Computed]):
+    """What ``compute`` gives under each parameter set asked for, each set computed once:
+    by identity, as sets are immutable (a diagnosis reads its models' simulations and their
+    relation checks in several places)."""
+
+    def __init__(self, compute: Callable[[RigParameters], Computed]) -> None:
+        self._compute = compute
+        self._done: list[tuple[RigParameters, Computed]] = []
+
+    def of(self, params: RigParameters) -> Computed:
+        """The value under ``params``."""
+        for done, value in self._done:
+            if done is params:
+                return value
+        value = self._compute(params)
+        self._done.append((params, value))
+        return value

@@ -131,6 +131,32 @@ def stop_pool(pool: ProcessPoolExecutor) -> None:
         writer.close()
 
 
+def fork_workers(tasks: int) -> int:
+    """Worker processes for ``tasks`` independent tasks: a core each, at most one per task;
+    under 2 where a pool would not pay (one core, one task) or may not be made (a daemonic
+    process, a Dask worker's, may not have children)."""
+    if multiprocessing.current_process().daemon:
+        return 1
+    return min(tasks, os.cpu_count() or 1)
+
+
+@contextmanager
+def forked_pool(workers: int, *initargs: Any) -> Iterator[ProcessPoolExecutor]:
+    """A pool of ``workers`` forked processes, :func:`pool_worker` their initializer (with
+    ``initargs``); its tasks are submitted under :func:`signals_held`, which forks them. An
+    exception inside, Ctrl-C and SIGTERM included, ends the workers at once
+    (:func:`stop_pool`): their tasks could run for minutes, and an executor's exit would
+    wait for them. Otherwise the pool is shut down once its tasks are done."""
+    pool = ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
+                               initializer=pool_worker, initargs=initargs)
+    try:
+        yield pool
+    except BaseException:
+        stop_pool(pool)
+        raise
+    pool.shutdown()
+
+
 Call = tuple[Callable[..., Result], tuple[Any, ...]]
 """A function defined at a module's top level and its arguments."""
 
@@ -145,27 +171,20 @@ def _call(index: int) -> Any:
 def map_forked(calls: Sequence[Call[Result]]) -> list[Result]:
     """Each call's result, in order, made on a forked process per core: for work that holds
     the GIL (matplotlib's drawing). The workers inherit the calls with the fork: their
-    arguments are never pickled, only the results. In this process where there is one
-    core, one call, or no room for children (a daemonic process: a Dask worker's). Ctrl-C
-    or SIGTERM ends the workers at once (:func:`stop_pool`)."""
+    arguments are never pickled, only the results. In this process where a pool would not
+    pay or may not be made (:func:`fork_workers`)."""
     global _CALLS
-    workers = min(len(calls), os.cpu_count() or 1)
-    if workers < 2 or multiprocessing.current_process().daemon:
+    workers = fork_workers(len(calls))
+    if workers < 2:
         return [function(*arguments) for function, arguments in calls]
     _CALLS = calls
-    pool = ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
-                               initializer=pool_worker)
     try:
-        with signals_held():
-            futures = [pool.submit(_call, i) for i in range(len(calls))]
-        results = [future.result() for future in futures]
-    except BaseException:
-        stop_pool(pool)
-        raise
+        with forked_pool(workers) as pool:
+            with signals_held():
+                futures = [pool.submit(_call, i) for i in range(len(calls))]
+            return [future.result() for future in futures]
     finally:
         _CALLS = ()
-    pool.shutdown()
-    return results
 
 
 def single_threaded_blas() -> AbstractContextManager[object]:

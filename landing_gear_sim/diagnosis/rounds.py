@@ -9,10 +9,8 @@ each model are computed once, beside the fits (:class:`Consistency`).
 from __future__ import annotations
 
 import contextvars
-import multiprocessing
-import os
 from collections.abc import Callable, Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field, replace
 
 from landing_gear_sim.calibration.identify import Progress, identify
@@ -38,9 +36,9 @@ from landing_gear_sim.errors import IdentificationError
 from landing_gear_sim.model.parameters import PerSet, RigParameters
 from landing_gear_sim.processes import (
     busy_counter,
-    pool_worker,
+    fork_workers,
+    forked_pool,
     signals_held,
-    stop_pool,
     working,
 )
 
@@ -162,39 +160,33 @@ def _score_all(pending: Sequence[Candidate], runs: Sequence[ClassifiedRun], mode
     before (by cause); in order of ``pending``. ``meanwhile`` runs in this process as they
     fit (its work is serial: the fits' threads leave room for it)."""
     ended = ended or {}
-    workers = min(len(pending), os.cpu_count() or 1)
-    if workers < 2 or multiprocessing.current_process().daemon:
-        # a daemonic process (a Dask worker's) may not have children
+    workers = fork_workers(len(pending))
+    if workers < 2:
         meanwhile()
         return [_score_one(c, runs, model, datasheet, scales, signatures,
                            ended.get(c.cause)) for c in pending]
-    # fork: the children inherit the compiled physics instead of compiling it again
-    context = multiprocessing.get_context("fork")
-    pool = ProcessPoolExecutor(workers, mp_context=context, initializer=pool_worker,
-                               initargs=(busy_counter(),))
     side = ThreadPoolExecutor(1)
     try:
-        # the costliest first (more fitted parameters: more simulations per step), so the
-        # last to finish is a short one; the first submission forks the workers
-        with signals_held():
-            futures = {pool.submit(_score_one, c, runs, model, datasheet, scales, signatures,
-                                   ended.get(c.cause)): c
-                       for c in sorted(pending, key=lambda c: -len({*c.keys, *c.free}))}
-        # on a thread only once the workers are forked: a fork while it holds a lock (an
-        # import's) would leave the child waiting on it; numpy's error state goes with it
-        beside = side.submit(contextvars.copy_context().run, meanwhile)
-        for future in as_completed(futures):
-            say(f"  {futures[future].cause} scored")
-        results = [next(f for f, c in futures.items() if c is candidate).result()
-                   for candidate in pending]
-        beside.result()
+        # fork: the children inherit the compiled physics instead of compiling it again
+        with forked_pool(workers, busy_counter()) as pool:
+            # the costliest first (more fitted parameters: more simulations per step), so
+            # the last to finish is a short one; the first submission forks the workers
+            with signals_held():
+                futures = {pool.submit(_score_one, c, runs, model, datasheet, scales,
+                                       signatures, ended.get(c.cause)): c
+                           for c in sorted(pending, key=lambda c: -len({*c.keys, *c.free}))}
+            # on a thread only once the workers are forked: a fork while it holds a lock
+            # (an import's) would leave the child waiting on it; numpy's error state goes
+            # with it
+            beside = side.submit(contextvars.copy_context().run, meanwhile)
+            for future in as_completed(futures):
+                say(f"  {futures[future].cause} scored")
+            results = [next(f for f, c in futures.items() if c is candidate).result()
+                       for candidate in pending]
+            beside.result()
     except BaseException:
-        # Ctrl-C or SIGTERM: the workers' fits could run for minutes; an executor's exit
-        # would wait for them
-        stop_pool(pool)
         side.shutdown(wait=False, cancel_futures=True)
         raise
-    pool.shutdown()
     side.shutdown()
     return results
 

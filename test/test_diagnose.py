@@ -792,7 +792,7 @@ def test_a_worker_killed_mid_result_does_not_hang_the_exit():
 
 
 _LATE_WORKER = """
-import contextlib, multiprocessing, signal, time
+import contextlib, multiprocessing, os, signal, time
 from concurrent.futures import ProcessPoolExecutor
 from landing_gear_sim.processes import pool_worker, signals_held, stop_pool
 
@@ -802,7 +802,10 @@ class Terminated(BaseException):  # what the CLI's SIGTERM handler raises
 def terminate(signum, frame):
     raise Terminated
 
+started, ready = os.pipe()
+
 def late_start():  # the moment between a worker's fork and its initializer, made long
+    os.write(ready, b".")
     time.sleep(1.0)
     pool_worker()
 
@@ -812,6 +815,9 @@ with {hold}:
                                initializer=late_start)
     pool.submit(abs, -1)
 [worker] = multiprocessing.active_children()
+# Python forgets a signal caught inside os.fork() itself (the child clears its pending
+# handlers): struck that early, the worker without the hold had run on (1 run in ~150)
+os.read(started, 1)
 stop_pool(pool)
 worker.join(5)  # past its initializer's second
 print(worker.exitcode)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import html
 import re
+from pathlib import Path
 
 import pytest
 
@@ -441,30 +442,85 @@ def test_figures_laid_out_by_fixed_margins_keep_every_label_inside_and_apart(
     assert [_laid_out_within(fig) for fig in saved] == [[], [], []]
 
 
-def test_a_page_drawn_side_by_side_is_the_page_drawn_on_one_core(reference, tmp_path,
-                                                                 monkeypatch):
-    """The page's figures are drawn on forked processes (a campaign's took 6.7 s on one
-    core): the same files, byte for byte, as drawn one after another."""
+def _two_stops(reference, *bars: float):
+    """A diagnosis of two constant-pressure stops (``bars``), each its own overlay and
+    residual spectrum: a page of 5 figures, drawn without diagnosing anything."""
     from landing_gear_sim.calibration.runs import classified
     from landing_gear_sim.diagnosis.diagnose import Diagnosis
     from landing_gear_sim.diagnosis.residuals import spectrum
     from landing_gear_sim.diagnosis.signatures import RunEvidence
     from landing_gear_sim.model import scenario as sc
     from landing_gear_sim.model.integrate import simulate
-    from landing_gear_sim.report.diagnosis import write_diagnosis_report
 
     def evidence(bar: float) -> RunEvidence:
-        run = simulate(reference, sc.constant_pressure_test(reference, bar * 1e5)).to_run(1)
+        run = dataclasses.replace(  # the same names, other figures, on each page
+            simulate(reference, sc.constant_pressure_test(reference, bar * 1e5)).to_run(1),
+            name=f"stop_{bars.index(bar)}")
         return RunEvidence(classified(run), run, run, "pressure_pa",
                            spectrum(run.pressure_pa - run.pressure_pa.mean(), 1000.0))
 
-    result = Diagnosis(verdict="none", findings=[], candidates=[], baseline={},
-                       start=reference, calibrated=reference, extended=reference,
-                       signatures_before=[], signatures_after=[],
-                       evidence=[evidence(20), evidence(30)])
+    return Diagnosis(verdict="none", findings=[], candidates=[], baseline={},
+                     start=reference, calibrated=reference, extended=reference,
+                     signatures_before=[], signatures_after=[],
+                     evidence=[evidence(bar) for bar in bars])
+
+
+def test_a_page_drawn_side_by_side_is_the_page_drawn_on_one_core(reference, tmp_path,
+                                                                 monkeypatch):
+    """The page's figures are drawn on forked processes (a campaign's took 6.7 s on one
+    core): the same files, byte for byte, as drawn one after another."""
+    from landing_gear_sim.report.diagnosis import write_diagnosis_report
+
+    result = _two_stops(reference, 20, 30)
     pages = _on_one_and_on_two_cores(lambda folder: write_diagnosis_report(result, folder),
                                      tmp_path, monkeypatch)
     assert len(pages[1]) == 6 and pages[1] == pages[2]  # the page, 2 runs' overlays, spectra
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    """Every file under ``folder`` (hidden ones too), by its path in it."""
+    return {str(path.relative_to(folder)): path.read_bytes()
+            for path in sorted(folder.rglob("*")) if path.is_file()}
+
+
+def _stopped_at(monkeypatch, module, name: str) -> None:
+    """The first drawing by ``module.name`` is stopped as by Ctrl-C; on one core, so that
+    the drawings before it are written."""
+    import os
+
+    monkeypatch.setattr(os, "cpu_count", lambda: 1)
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(module, name, interrupted)
+
+
+def test_a_page_stopped_midway_leaves_the_page_before_it_as_it_was(reference, tmp_path,
+                                                                   monkeypatch):
+    """A page's files are written into a stage and moved into its folder once all are
+    drawn, the page last. Ctrl-C while drawing had left the page before it beside the new
+    figures drawn so far (the first screen and a run's overlay, read by its page as its
+    own): one page that showed two diagnoses."""
+    from landing_gear_sim.report import diagnosis as page
+
+    folder = tmp_path / "report"
+    page.write_diagnosis_report(_two_stops(reference, 20, 30), folder)
+    before = _files(folder)
+    _stopped_at(monkeypatch, page, "plot_spectrum")
+    with pytest.raises(KeyboardInterrupt):
+        page.write_diagnosis_report(_two_stops(reference, 25, 35), folder)
+    assert _files(folder) == before and len(before) == 6
+
+
+def test_a_page_written_again_whole_replaces_every_file_it_draws(reference, tmp_path):
+    from landing_gear_sim.report.diagnosis import write_diagnosis_report
+
+    folder, apart = tmp_path / "report", tmp_path / "apart"
+    write_diagnosis_report(_two_stops(reference, 20, 30), folder)
+    write_diagnosis_report(_two_stops(reference, 25, 35), folder)
+    write_diagnosis_report(_two_stops(reference, 25, 35), apart)
+    assert _files(folder) == _files(apart) and len(_files(apart)) == 6
 
 
 def _on_one_and_on_two_cores(write, tmp_path, monkeypatch) -> dict[int, dict[str, bytes]]:
@@ -494,3 +550,24 @@ def test_a_validation_page_drawn_side_by_side_is_the_one_drawn_on_one_core(refer
         lambda folder: write_validation_report(validation, folder, "validation"), tmp_path,
         monkeypatch)
     assert len(pages[1]) == 4 and pages[1] == pages[2]  # the page, the curve, 2 overlays
+
+
+def test_a_validation_page_stopped_midway_leaves_the_page_before_it_as_it_was(
+        reference, tmp_path, monkeypatch):
+    from landing_gear_sim.calibration.validate import validate_campaign
+    from landing_gear_sim.model import scenario as sc
+    from landing_gear_sim.model.integrate import simulate
+    from landing_gear_sim.report import validation as page
+
+    def validation(*bars: float):
+        runs = [dataclasses.replace(simulate(reference, sc.constant_pressure_test(
+            reference, bar * 1e5)).to_run(1), name=f"stop_{i}") for i, bar in enumerate(bars)]
+        return validate_campaign(runs, reference)
+
+    folder = tmp_path / "report"
+    page.write_validation_report(validation(20, 30), folder, "before")
+    before = _files(folder)
+    _stopped_at(monkeypatch, page, "plot_overlay")
+    with pytest.raises(KeyboardInterrupt):
+        page.write_validation_report(validation(25, 35), folder, "after")
+    assert _files(folder) == before and len(before) == 4

@@ -3,8 +3,14 @@
 from __future__ import annotations
 
 import html
-from collections.abc import Sequence
+import shutil
+import tempfile
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
+
+PAGE_FILE = "index.html"
+"""A report folder's page; its figures are files beside it."""
 
 
 def text_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
@@ -41,6 +47,28 @@ def write_html(path: Path, title: str, sections: Sequence[tuple[str, str]],
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(page)
     return path
+
+
+@contextmanager
+def staged(folder: Path) -> Iterator[Path]:
+    """A folder to write a report into; once all is written, its files are moved into
+    ``folder``, the page last. A report stopped midway (Ctrl-C, SIGTERM, an error) had left
+    the page before it beside the new figures drawn so far, which it showed as its own:
+    now that report stays as it was, and nothing of the new one is left. The stage is a
+    hidden folder inside ``folder``, on its file system: each move is a rename."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=".writing-", dir=folder))
+    try:
+        yield stage
+        written = sorted((path for path in stage.rglob("*") if path.is_file()),
+                         key=lambda path: path.relative_to(stage) == Path(PAGE_FILE))
+        for path in written:
+            target = folder / path.relative_to(stage)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            path.replace(target)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
 
 
 def _anchor(heading: str) -> str:

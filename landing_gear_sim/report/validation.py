@@ -28,7 +28,7 @@ from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import friction_at, friction_coefficients
 from landing_gear_sim.processes import Call, map_forked
 from landing_gear_sim.report.figures import DISPLAY_UNITS, fixed_margins, save_figure
-from landing_gear_sim.report.pages import html_image, html_table, write_html
+from landing_gear_sim.report.pages import PAGE_FILE, html_image, html_table, staged, write_html
 
 
 def plot_overlay(comparison: RunComparison, path: Path) -> Path:
@@ -213,7 +213,16 @@ FIT_DEFINITION = ("<p>fit % = 100·(1 − ‖y − ŷ‖ / ‖y − ȳ‖), y me
 
 
 def write_validation_report(validation: Validation, folder: Path, title: str) -> Path:
-    """The validation page ``folder/index.html`` with its figures; returns the page."""
+    """The validation page ``folder/index.html`` with its figures, all or nothing
+    (:func:`~landing_gear_sim.report.pages.staged`); returns the page."""
+    with staged(folder) as stage:
+        write_html(stage / PAGE_FILE, title, _validation_sections(validation, stage),
+                   first_screen=3)
+    return folder / PAGE_FILE
+
+
+def _validation_sections(validation: Validation, folder: Path) -> list[tuple[str, str]]:
+    """The validation page's sections; its figures are drawn into ``folder``."""
     sources = ", ".join(validation.params.sources)
     verdicts = channel_verdicts(validation.comparisons)
     sections = [("Verdict", f"<p><b>{html.escape(validation_sentence(verdicts))}</b></p>"
@@ -236,6 +245,5 @@ def write_validation_report(validation: Validation, folder: Path, title: str) ->
                 for c in validation.comparisons]
     # drawn side by side: `validate --report` of campaign_v1 (10 figures) took 7.9 s, 5.7 now
     drawn = map_forked([call for _, call in figures])
-    sections += [(name, html_image(figure, folder))
-                 for (name, _), figure in zip(figures, drawn, strict=True)]
-    return write_html(folder / "index.html", title, sections, first_screen=3)
+    return sections + [(name, html_image(figure, folder))
+                       for (name, _), figure in zip(figures, drawn, strict=True)]

@@ -148,8 +148,10 @@ def actuator_frf(run: Run, params: RigParameters) -> FrfEstimate:
     nperseg = min(4096, u.size // 4)
     f, puu = scipy.signal.welch(u - u.mean(), fs, nperseg=nperseg)
     _, pyu = scipy.signal.csd(u - u.mean(), y - y.mean(), fs, nperseg=nperseg)
-    _, coherence = scipy.signal.coherence(u, y, fs, nperseg=nperseg)
+    # bands the input does not excite (a short log's) have no power: no H1 and no
+    # coherence there (NaN), which the fit leaves out, and no warning on the terminal
     with np.errstate(divide="ignore", invalid="ignore"):
+        _, coherence = scipy.signal.coherence(u, y, fs, nperseg=nperseg)
         h1 = pyu / puu  # scipy's csd(u, y) is already the cross-spectrum of H1
     model = second_order_response(f, params.number(K.ACTUATOR_NATURAL_FREQUENCY_HZ),
                                   params.number(K.ACTUATOR_DAMPING_RATIO), 1.0)

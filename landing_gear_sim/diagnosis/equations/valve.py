@@ -393,8 +393,11 @@ class ValveDynamicsLibrary(Library[ValveRun]):
         t = np.full(values.size, np.inf)
         for _ in range(REFINE_STEPS):
             trial = _moved(params, [int(s.term.code or 0) for s in chosen], values, owned)
-            rows = [r for run in runs if trial is not None
-                    and (r := self.rows(valve_run(run, trial), trial, terms)) is not None]
+            # a step the valve may not survive runs its states off to inf: the check below
+            # says so, where numpy's warnings had reached the terminal
+            with np.errstate(over="ignore", invalid="ignore"):
+                rows = [r for run in runs if trial is not None
+                        and (r := self.rows(valve_run(run, trial), trial, terms)) is not None]
             if trial is None or not rows:
                 return None
             design = np.vstack([np.hstack([r.terms, r.owned]) for r in rows])

@@ -9,7 +9,7 @@ from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.calibration.identify import identify
 from landing_gear_sim.calibration.runs import classify_all
 from landing_gear_sim.diagnosis.catalogue import CATALOGUE, fit_candidate, gear_walk_key_parameters
-from landing_gear_sim.diagnosis.local import campaign_gain
+from landing_gear_sim.diagnosis.local_gain import campaign_gain
 from msg_tools.io import read_campaign
 
 ACTUATOR_RUNS = ("actuator_ramp", "actuator_steps_sweep")

@@ -27,7 +27,7 @@ from landing_gear_sim.diagnosis.equations import registry as eq
 from landing_gear_sim.diagnosis.equations.tyre import locked_sliding
 from landing_gear_sim.diagnosis.families import HIDDEN
 from landing_gear_sim.diagnosis.library import Campaign
-from landing_gear_sim.diagnosis.local import local_gains
+from landing_gear_sim.diagnosis.local_gain import local_gains
 from landing_gear_sim.diagnosis.relations import Relation, violations
 from landing_gear_sim.model import basis
 from landing_gear_sim.model import elements as el

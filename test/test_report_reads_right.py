@@ -240,7 +240,7 @@ def test_the_local_gain_figure_keeps_its_keys_off_the_estimates(tmp_path, monkey
     lines that zig-zagged up and down at 10 bar."""
     import numpy as np
 
-    from landing_gear_sim.diagnosis.local import VARIABLES, LocalGain
+    from landing_gear_sim.diagnosis.local_gain import VARIABLES, LocalGain
     from landing_gear_sim.report import local
 
     def gain(variable: str, run: str = "campaign") -> LocalGain:

@@ -34,7 +34,7 @@ from landing_gear_sim.calibration.statistics import (
     negligible_gain,
 )
 from landing_gear_sim.diagnosis.equations.tyre import relaxation_read
-from landing_gear_sim.diagnosis.local import campaign_gain
+from landing_gear_sim.diagnosis.local_gain import campaign_gain
 from landing_gear_sim.diagnosis.objective import (
     Scales,
     scaled_residuals,

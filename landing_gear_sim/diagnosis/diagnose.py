@@ -44,7 +44,7 @@ from landing_gear_sim.diagnosis.equations.placing import locate_all
 from landing_gear_sim.diagnosis.families import EQUATIONS
 from landing_gear_sim.diagnosis.findings import Finding, Signature, approximations
 from landing_gear_sim.diagnosis.identifiability import actuator_calibrated, untestable
-from landing_gear_sim.diagnosis.local import LocalGain, local_gains
+from landing_gear_sim.diagnosis.local_gain import LocalGain, local_gains
 from landing_gear_sim.diagnosis.misfit import misfit_finding, misfits
 from landing_gear_sim.diagnosis.next_run import Explanation, NextRun, next_run
 from landing_gear_sim.diagnosis.relations import Check, structural

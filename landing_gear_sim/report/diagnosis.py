@@ -29,7 +29,7 @@ from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.processes import Call, map_forked
 from landing_gear_sim.report.figures import DISPLAY_UNITS, fixed_margins, save_figure
 from landing_gear_sim.report.first_screen import first_figure
-from landing_gear_sim.report.local import local_gain_section
+from landing_gear_sim.report.local_gain import local_gain_section
 from landing_gear_sim.report.pages import (
     PAGE_FILE,
     html_image,

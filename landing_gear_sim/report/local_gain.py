@@ -1,6 +1,6 @@
 """The brake gain re-estimated locally, as a figure: per band of each physical variable
 (calibrated and extended model side by side) and along each run. Takes the estimates
-(:mod:`landing_gear_sim.diagnosis.local`), never recomputes them."""
+(:mod:`landing_gear_sim.diagnosis.local_gain`), never recomputes them."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 
-from landing_gear_sim.diagnosis.local import VARIABLES, LocalGain
+from landing_gear_sim.diagnosis.local_gain import VARIABLES, LocalGain
 from landing_gear_sim.report.figures import save_figure
 from landing_gear_sim.report.pages import html_image, html_table
 

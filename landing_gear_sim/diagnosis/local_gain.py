@@ -9,7 +9,7 @@ the model gives those samples (its slopes, fade and drift included), so a model 
 right reads 1 everywhere. A weighted straight line through the band estimates gives the
 relative change over the range and its z (σ scaled up to the scatter about the line).
 These are a look, not a verdict: the violations are judged by the consistency checks.
-No plotting here (:mod:`landing_gear_sim.report.local`).
+No plotting here (:mod:`landing_gear_sim.report.local_gain`).
 """
 
 from __future__ import annotations

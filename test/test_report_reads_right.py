@@ -241,7 +241,7 @@ def test_the_local_gain_figure_keeps_its_keys_off_the_estimates(tmp_path, monkey
     import numpy as np
 
     from landing_gear_sim.diagnosis.local_gain import VARIABLES, LocalGain
-    from landing_gear_sim.report import local
+    from landing_gear_sim.report import local_gain
 
     def gain(variable: str, run: str = "campaign") -> LocalGain:
         centres = np.array([10.0, 10.0, 10.0, 19.0, 30.0])
@@ -249,9 +249,9 @@ def test_the_local_gain_figure_keeps_its_keys_off_the_estimates(tmp_path, monkey
                          np.array([0.997, 1.0, 1.003, 1.0007, 1.0003]), np.full(5, 3e-4),
                          0.001, 0.002)
 
-    saved = _figures_saved(monkeypatch, local)
-    local.plot_local_gains([gain(v) for v in VARIABLES] + [gain("time in run", "stop")],
-                           [gain(v) for v in VARIABLES], tmp_path / "l.png")
+    saved = _figures_saved(monkeypatch, local_gain)
+    local_gain.plot_local_gains([gain(v) for v in VARIABLES] + [gain("time in run", "stop")],
+                                [gain(v) for v in VARIABLES], tmp_path / "l.png")
     (fig,) = saved
     assert _legends_off_the_axes(fig)
     bands = [line for axis in fig.axes[:len(VARIABLES)] for line in axis.get_lines()

@@ -130,7 +130,7 @@ FADE_STD = 0.005  # how well the bands must read the fall for one they do not re
 
 def fade_evidence(runs: Sequence[ClassifiedRun], params: RigParameters) -> str:
     """A fade lowers the brake's gain as the brake absorbs energy: under the calibrated
-    model the gain re-estimated in bands of absorbed energy (:func:`~.local.campaign_gain`)
+    model the gain re-estimated in bands of absorbed energy (:func:`~.local_gain.campaign_gain`)
     falls with it, by FADE_Z σ or more. Where it does not, no fade is fitted: its fit and its
     null had taken 42 % of the fits' time in 22 campaigns without a fade. Fades of 2-8 %
     read a fall of 9.8-17σ (the calibration takes half of it), I01's 15 % 10.8σ. Where the

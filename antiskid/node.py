@@ -16,15 +16,11 @@ from dataclasses import fields
 from sensor_msgs.msg import JointState
 
 from landing_gear_sim.model.blocks import step_time
-from landing_gear_sim.ros.nodes.common import (
-    GraphNode,
-    Handshake,
-    RunClock,
-    announce_ready,
-    command_message,
-    main_for,
-)
+from landing_gear_sim.ros.nodes.graph_node import GraphNode, main_for
+from landing_gear_sim.ros.nodes.handshake import Handshake, announce_ready
 from landing_gear_sim.ros.nodes.parameters import declare, rig_and_run
+from landing_gear_sim.ros.nodes.stamps import RunClock
+from landing_gear_sim.ros.nodes.topics import command_message
 from msg_tools.contract import TOPIC_CURRENT, TOPIC_FLYWHEEL, TOPIC_WHEEL
 
 from .closed_loop import CONTROLLERS, make_controller, settings_type

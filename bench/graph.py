@@ -54,7 +54,7 @@ def realtime_periods(duration_s: float) -> tuple[float, float, float]:
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from sensor_msgs.msg import JointState
 
-    from landing_gear_sim.ros.nodes.common import spin
+    from landing_gear_sim.ros.nodes.graph_node import spin
     from msg_tools.contract import TOPIC_WHEEL
 
     rclpy.init()

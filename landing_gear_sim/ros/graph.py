@@ -207,7 +207,7 @@ def options_from_arguments(values: dict[str, str]) -> tuple[GraphOptions, Path]:
 
 
 def run_parameters(run: RunSpec) -> dict[str, ParamValue]:
-    """The ``run.*`` node parameters that rebuild ``run`` (see nodes.common.run_spec)."""
+    """The ``run.*`` node parameters that rebuild ``run`` (see nodes.parameters.run_spec)."""
     return {"run.profile": run.profile, "run.pressure_pa": run.pressure_pa,
             "run.current_a": -1.0 if math.isnan(run.current_a) else run.current_a,
             "run.file": run.file, "run.contact": run.contact,

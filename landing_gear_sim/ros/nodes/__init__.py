@@ -7,7 +7,7 @@ Importing a node takes seconds (numpy, numba, rclpy). A Ctrl-C or SIGTERM in tha
 (``ros2 launch`` stopped right after it started) used to end the process with a
 KeyboardInterrupt traceback and −2, or an ImportError when it hit numpy's import. So the
 signals are only noted here; once rclpy has installed its own handlers,
-:func:`~landing_gear_sim.ros.nodes.common.run_node` stops cleanly if one came.
+:func:`~landing_gear_sim.ros.nodes.graph_node.run_node` stops cleanly if one came.
 
 A node also ends when whoever started it is gone: a supervisor's SIGTERM ends ``ros2
 launch`` in milliseconds and launch does not take its nodes along, which then ran on as

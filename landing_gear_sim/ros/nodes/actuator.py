@@ -20,16 +20,11 @@ from sensor_msgs.msg import FluidPressure, JointState
 
 from landing_gear_sim.model.blocks import ActuatorBlock
 from landing_gear_sim.ros.graph import TOPIC_HYDRAULIC
-from landing_gear_sim.ros.nodes.common import (
-    GraphNode,
-    Handshake,
-    RunClock,
-    announce_ready,
-    command_current,
-    main_for,
-    ns_of,
-)
+from landing_gear_sim.ros.nodes.graph_node import GraphNode, main_for
+from landing_gear_sim.ros.nodes.handshake import Handshake, announce_ready
 from landing_gear_sim.ros.nodes.parameters import rig_and_run
+from landing_gear_sim.ros.nodes.stamps import RunClock, ns_of
+from landing_gear_sim.ros.nodes.topics import command_current
 from msg_tools.contract import ATMOSPHERE_PA, TOPIC_CURRENT, VALVE_JOINT
 
 

@@ -7,14 +7,10 @@ from sensor_msgs.msg import JointState
 
 from landing_gear_sim.model.blocks import LoadingBlock
 from landing_gear_sim.ros.graph import TOPIC_LOAD
-from landing_gear_sim.ros.nodes.common import (
-    GraphNode,
-    Handshake,
-    RunClock,
-    announce_ready,
-    main_for,
-)
+from landing_gear_sim.ros.nodes.graph_node import GraphNode, main_for
+from landing_gear_sim.ros.nodes.handshake import Handshake, announce_ready
 from landing_gear_sim.ros.nodes.parameters import rig_and_run
+from landing_gear_sim.ros.nodes.stamps import RunClock
 from msg_tools.contract import TOPIC_FLYWHEEL
 
 

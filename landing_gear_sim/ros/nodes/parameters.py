@@ -1,7 +1,7 @@
 """The parameters of a graph node: declared with descriptors, checked against what the
 node and the graph know, and read once, when the run is built.
 
-``ros2 param list/get/describe`` answer (see :func:`common.spin`); every parameter is
+``ros2 param list/get/describe`` answer (see :func:`graph_node.spin`); every parameter is
 read-only, with its range where it has one (:func:`declare`), and ``ros2 param set`` on
 what rclpy declares itself is refused with the reason (:func:`refuse_changes`); a name
 nothing reads stops the node with the closest known one (:func:`check_overrides`).

@@ -38,18 +38,11 @@ from landing_gear_sim.ros.graph import (
     TOPIC_READY,
     TOPIC_RUN_END,
 )
-from landing_gear_sim.ros.nodes.common import (
-    DATA_QOS,
-    LATCHED_QOS,
-    GraphNode,
-    Handshake,
-    RunClock,
-    RunFinishedError,
-    main_for,
-    outside_gaps,
-    read_ready,
-)
+from landing_gear_sim.ros.nodes.graph_node import GraphNode, RunFinishedError, main_for
+from landing_gear_sim.ros.nodes.handshake import Handshake, read_ready
 from landing_gear_sim.ros.nodes.parameters import declare, rig_and_run
+from landing_gear_sim.ros.nodes.stamps import RunClock
+from landing_gear_sim.ros.nodes.topics import DATA_QOS, LATCHED_QOS, outside_gaps
 from msg_tools.contract import (
     ATMOSPHERE_PA,
     TOPIC_FLYWHEEL,

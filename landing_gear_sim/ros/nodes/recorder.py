@@ -27,17 +27,10 @@ from pathlib import Path
 from landing_gear_sim.errors import GraphError
 from landing_gear_sim.ros.graph import RECORDER, SENSOR_TOPICS
 from landing_gear_sim.ros.nodes import stop_requested
-from landing_gear_sim.ros.nodes.common import (
-    CONTRACT_KINDS,
-    DATA_QOS,
-    GraphNode,
-    Handshake,
-    announce_ready,
-    main_for,
-    relative,
-    say,
-)
+from landing_gear_sim.ros.nodes.graph_node import GraphNode, main_for, say
+from landing_gear_sim.ros.nodes.handshake import Handshake, announce_ready
 from landing_gear_sim.ros.nodes.parameters import check_overrides, declare, lockstep
+from landing_gear_sim.ros.nodes.topics import CONTRACT_KINDS, DATA_QOS, relative
 from msg_tools.bag_segments import SegmentedBagWriter
 from msg_tools.contract import TOPIC_CURRENT, TOPIC_TYPES, TOPIC_WHEEL
 

@@ -21,17 +21,12 @@ from std_msgs.msg import UInt64
 from landing_gear_sim.errors import GraphError
 from landing_gear_sim.model.runspec import build_scenario
 from landing_gear_sim.ros.graph import TOPIC_CLOCK, TOPIC_RUN_END
-from landing_gear_sim.ros.nodes.common import (
-    CONTRACT_KINDS,
-    DATA_QOS,
-    LATCHED_QOS,
-    GraphNode,
-    Handshake,
-    main_for,
-    to_stamp,
-)
+from landing_gear_sim.ros.nodes.graph_node import GraphNode, main_for
+from landing_gear_sim.ros.nodes.handshake import Handshake
 from landing_gear_sim.ros.nodes.parameters import declare, lockstep, rig_parameters, run_spec
 from landing_gear_sim.ros.nodes.profile import CurrentFeed
+from landing_gear_sim.ros.nodes.stamps import to_stamp
+from landing_gear_sim.ros.nodes.topics import CONTRACT_KINDS, DATA_QOS, LATCHED_QOS
 from msg_tools.bag_io import TYPESTORE, contract_messages
 from msg_tools.contract import TOPIC_CURRENT, TOPIC_TYPES
 from msg_tools.csv_io import read_mapping

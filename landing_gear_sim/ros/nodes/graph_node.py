@@ -1,4 +1,4 @@
-"""What every node of the graph shares: parameters, QoS, stamps, the start handshake, main().
+"""A node of the rig graph: its base class, its lean spin loop, and its process's main().
 
 The nodes are thin: they declare parameters, create publishers and subscriptions,
 and call the blocks of :mod:`landing_gear_sim.model.blocks` once per message.
@@ -11,218 +11,28 @@ import os
 import signal
 import sys
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from typing import Any
 
 import rclpy
-from builtin_interfaces.msg import Time
-from geometry_msgs.msg import WrenchStamped
 from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
-from rclpy.node import Node, NodeNameNonExistentError
+from rclpy.node import Node
 from rclpy.publisher import Publisher
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import QoSProfile
 from rclpy.signals import SignalHandlerGuardCondition
 from rclpy.subscription import Subscription
-from sensor_msgs.msg import FluidPressure, JointState
-from std_msgs.msg import String, UInt64
+from std_msgs.msg import UInt64
 
-from landing_gear_sim.errors import GraphError, LandingGearSimError
-from landing_gear_sim.model.blocks import step_time
-from landing_gear_sim.ros.graph import TOPIC_READY, TOPIC_RUN_END
+from landing_gear_sim.errors import LandingGearSimError
+from landing_gear_sim.ros.graph import TOPIC_RUN_END
 from landing_gear_sim.ros.nodes import stop_requested
 from landing_gear_sim.ros.nodes.parameters import check_overrides, declare, refuse_changes
-from msg_tools.contract import (
-    NAMESPACE,
-    TOPIC_CURRENT,
-    TOPIC_FLYWHEEL,
-    TOPIC_PRESSURE,
-    TOPIC_TYPES,
-    TOPIC_WHEEL,
-    TOPIC_WRENCH,
-    VALVE_JOINT,
-)
+from landing_gear_sim.ros.nodes.topics import DATA_QOS, LATCHED_QOS, relative
+from msg_tools.contract import NAMESPACE
 
 RCLError = _rclpy.RCLError  # what rcl raises once its context is shut down
-
-DATA_QOS = QoSProfile(reliability=ReliabilityPolicy.RELIABLE, history=HistoryPolicy.KEEP_LAST,
-                      depth=5000, durability=DurabilityPolicy.VOLATILE)
-"""Every data link: reliable, and deep enough that a slow recorder loses nothing for seconds."""
-LATCHED_QOS = QoSProfile(reliability=ReliabilityPolicy.RELIABLE,
-                         history=HistoryPolicy.KEEP_LAST, depth=50,
-                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
-"""Run end and readiness: late joiners still get them."""
-
-HANDSHAKE_PERIOD_S = 0.02
-
-CONTRACT_KINDS = {TOPIC_CURRENT: JointState, TOPIC_PRESSURE: FluidPressure, TOPIC_WHEEL: JointState,
-                  TOPIC_FLYWHEEL: JointState, TOPIC_WRENCH: WrenchStamped}
-"""rclpy message class of each contract topic (msg_tools.contract.TOPIC_TYPES)."""
-
-
-def to_stamp(time_s: float) -> Time:
-    return stamp_of_ns(round(time_s * 1e9))
-
-
-def stamp_of_ns(nanoseconds: int) -> Time:
-    return Time(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
-
-
-def ns_of(stamp: Time) -> int:
-    return stamp.sec * 1_000_000_000 + stamp.nanosec
-
-
-class RunClock:
-    """Sample k of a run ↔ its stamp: origin + k·h, to the nanosecond.
-
-    Lockstep runs on sim time from 0 (``origin_ns=0``). In real time the plant stamps
-    sample 0 with the ROS clock when the run starts, and every other node takes that stamp
-    as the origin from the first sample it receives (:meth:`observe`), so stamps are ROS
-    time (``ros2 topic delay`` works) and indices stay exact.
-    """
-
-    def __init__(self, step_s: float, origin_ns: int | None = 0) -> None:
-        self.step_s = step_s
-        self.origin_ns = origin_ns
-
-    def observe(self, stamp: Time) -> None:
-        """Take ``stamp`` as the origin if none is known yet (the run's first sample)."""
-        if self.origin_ns is None:
-            self.origin_ns = ns_of(stamp)
-
-    def step_of(self, stamp: Time) -> int:
-        """The step a stamp belongs to (stamps are origin + k·h rounded to 1 ns)."""
-        return round((ns_of(stamp) - (self.origin_ns or 0)) * 1e-9 / self.step_s)
-
-    def stamp(self, step: int) -> Time:
-        return stamp_of_ns((self.origin_ns or 0) + round(step_time(step, self.step_s) * 1e9))
-
-
-def command_message() -> JointState:
-    """A brake command to fill: ``effort[0]`` is the valve current [A]; the stamp ends the
-    interval it holds for (:data:`msg_tools.contract.TOPIC_CURRENT`)."""
-    message = JointState(name=[VALVE_JOINT], effort=[0.0])
-    message.header.frame_id = VALVE_JOINT
-    return message
-
-
-def command_current(message: JointState) -> float | None:
-    """The valve current [A] a command carries, or None when it names no valve effort."""
-    names = list(message.name)
-    index = names.index(VALVE_JOINT) if VALVE_JOINT in names else 0 if not names else -1
-    return float(message.effort[index]) if 0 <= index < len(message.effort) else None
-
-
-class Handshake:
-    """Start only when every link is matched.
-
-    A node is *linked* when each of its publishers has the number of matched
-    subscribers the graph description expects (``expected_subscribers``:
-    ``topic=count``) and each of its subscriptions has a publisher. Peers announce
-    it on :data:`TOPIC_READY`; the plant waits for them (``peers``).
-    """
-
-    def __init__(self, node: Node, publishers: dict[str, Any], subscriptions: Iterable[Any],
-                 on_linked: Callable[[], None], expected: dict[str, int] | None = None) -> None:
-        self._node = node
-        if expected is None:
-            expected = _parse_counts(declare(node, "expected_subscribers", [""],
-                                             "topic=count: matched readers to wait for"))
-        self._expected = expected
-        self._publishers = publishers
-        self._subscriptions = list(subscriptions)
-        self._on_linked = on_linked
-        self._started = time.monotonic()
-        self._timer = node.create_timer(HANDSHAKE_PERIOD_S, self._check)
-
-    def missing(self) -> list[str]:
-        """Links not matched yet, in words."""
-        gaps = [f"{topic} has {self._publishers[topic].get_subscription_count()}/{count} readers"
-                for topic, count in self._expected.items()
-                if self._publishers[topic].get_subscription_count() < count]
-        gaps += [f"no publisher on {s.topic_name}" for s in self._subscriptions
-                 if s.get_publisher_count() < 1]
-        return gaps
-
-    def _check(self) -> None:
-        if self.missing():
-            return
-        self._timer.cancel()
-        self._node.destroy_timer(self._timer)
-        self._on_linked()
-
-
-def _parse_counts(items: Iterable[str]) -> dict[str, int]:
-    counts = {}
-    for item in items:
-        if not item:
-            continue
-        topic, _, count = str(item).partition("=")
-        if not count.isdigit():
-            raise GraphError(f"expected_subscribers: {item!r} is not topic=count")
-        counts[topic] = int(count)
-    return counts
-
-
-def ready_message(name: str, run_id: str) -> str:
-    """What a node says on TOPIC_READY: its name and its session (see :func:`read_ready`)."""
-    return f"{name} {run_id}".rstrip()
-
-
-def read_ready(text: str) -> tuple[str, str]:
-    """(node name, session) of a TOPIC_READY message (a node name holds no space)."""
-    name, _, run_id = text.partition(" ")
-    return name, run_id
-
-
-def announce_ready(node: GraphNode) -> Callable[[], None]:
-    """A callback that tells the plant this node is linked (latched, once)."""
-    publisher = node.publisher(String, TOPIC_READY, LATCHED_QOS)
-
-    def ready() -> None:
-        publisher.publish(String(data=ready_message(node.get_name(), node.run_id)))
-        node.get_logger().info("linked; waiting for the plant")
-
-    return ready
-
-
-def outside_gaps(node: Node, publishers: dict[str, Publisher]) -> list[str]:
-    """What the graph shows that is not linked yet, in words: readers of ``publishers``
-    not matched, no node publishing brake commands, or a command publisher (an outside
-    controller the plant was not told about) that does not read the plant's samples yet."""
-    gaps = [f"{p.topic_name}: {p.get_subscription_count()} of {shown} readers matched"
-            for p in publishers.values()
-            if (shown := node.count_subscribers(p.topic_name)) > p.get_subscription_count()]
-    commands = command_topic(node)
-    samples = node.resolve_topic_name(relative(TOPIC_WHEEL))
-    writers = {_full_name(i) for i in node.get_publishers_info_by_topic(commands)}
-    readers = {_full_name(i) for i in node.get_subscriptions_info_by_topic(samples)}
-    if not writers:
-        gaps.append(f"no node publishes brake commands on {commands} (an outside controller "
-                    "not started?)")
-    gaps += [f"{name} publishes {commands} but does not read {samples} yet"
-             for name in sorted(writers - readers)]
-    return gaps
-
-
-def command_topic(node: Node) -> str:
-    """The topic the actuator beside ``node`` reads brake commands from, as the graph shows
-    it: a user remaps it on the actuator and the command source (``-r
-    brake/current_ref:=brake/cmd``), not on the plant. The contract's name, resolved for
-    ``node``, while no actuator is seen."""
-    default = node.resolve_topic_name(relative(TOPIC_CURRENT))
-    try:
-        read = node.get_subscriber_names_and_types_by_node("actuator", node.get_namespace())
-    except NodeNameNonExistentError:
-        return default
-    commands = [topic for topic, types in read if TOPIC_TYPES[TOPIC_CURRENT] in types]
-    return commands[0] if len(commands) == 1 else default
-
-
-def _full_name(endpoint: Any) -> str:
-    return f"{endpoint.node_namespace.rstrip('/')}/{endpoint.node_name}"
-
 
 _NO_PUB_EVENTS = PublisherEventCallbacks(use_default_callbacks=False)
 _NO_SUB_EVENTS = SubscriptionEventCallbacks(use_default_callbacks=False)
@@ -236,11 +46,6 @@ def say(node: Node, message: str) -> None:
     else:
         print(f"[{node.get_name()}] {message}", file=sys.stderr, flush=True)
 
-
-def relative(topic: str) -> str:
-    """A contract topic (``/rig/brake/pressure``) relative to the node's namespace
-    (``brake/pressure``), so that the namespace moves it; others (``/clock``) as they are."""
-    return topic.removeprefix(f"/{NAMESPACE}/")
 
 
 class RunFinishedError(Exception):

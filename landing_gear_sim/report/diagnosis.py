@@ -30,14 +30,7 @@ from landing_gear_sim.processes import Call, map_forked
 from landing_gear_sim.report.figures import DISPLAY_UNITS, fixed_margins, save_figure
 from landing_gear_sim.report.first_screen import first_figure
 from landing_gear_sim.report.local_gain import local_gain_section
-from landing_gear_sim.report.pages import (
-    PAGE_FILE,
-    html_image,
-    html_table,
-    staged,
-    text_table,
-    write_html,
-)
+from landing_gear_sim.report.pages import html_image, html_table, text_table, write_report
 from landing_gear_sim.report.words import (
     candidate_values,
     evidence_class,
@@ -117,13 +110,12 @@ def psd_unit(unit: str) -> str:
 
 def write_diagnosis_report(result: Diagnosis, folder: Path) -> Path:
     """The diagnosis page ``folder/index.html`` with its figures, all or nothing
-    (:func:`~landing_gear_sim.report.pages.staged`); returns the page."""
+    (:func:`~landing_gear_sim.report.pages.write_report`); returns the page."""
     best = result.findings[0] if result.findings else None
     title = title_words(best, result.verdict)
-    with staged(folder) as stage:
-        write_html(stage / PAGE_FILE, f"Diagnosis: {title[0].upper()}{title[1:]}",
-                   diagnosis_sections(result, stage), first_screen=3 if result.problems else 2)
-    return folder / PAGE_FILE
+    return write_report(folder, f"Diagnosis: {title[0].upper()}{title[1:]}",
+                        lambda stage: diagnosis_sections(result, stage),
+                        first_screen=3 if result.problems else 2)
 
 
 BASELINE_DEFINITION = (

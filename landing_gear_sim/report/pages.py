@@ -5,7 +5,7 @@ from __future__ import annotations
 import html
 import shutil
 import tempfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -47,6 +47,17 @@ def write_html(path: Path, title: str, sections: Sequence[tuple[str, str]],
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(page)
     return path
+
+
+def write_report(folder: Path, title: str,
+                 sections: Callable[[Path], Sequence[tuple[str, str]]],
+                 first_screen: int | None = None) -> Path:
+    """A report page ``folder/index.html`` (:func:`write_html`) with the figures that
+    ``sections`` draws into the folder it is given, all or nothing (:func:`staged`);
+    returns the page."""
+    with staged(folder) as stage:
+        write_html(stage / PAGE_FILE, title, sections(stage), first_screen)
+    return Path(folder) / PAGE_FILE
 
 
 @contextmanager

@@ -28,7 +28,7 @@ from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.model.quantities import friction_at, friction_coefficients
 from landing_gear_sim.processes import Call, map_forked
 from landing_gear_sim.report.figures import DISPLAY_UNITS, fixed_margins, save_figure
-from landing_gear_sim.report.pages import PAGE_FILE, html_image, html_table, staged, write_html
+from landing_gear_sim.report.pages import html_image, html_table, write_report
 
 
 def plot_overlay(comparison: RunComparison, path: Path) -> Path:
@@ -214,11 +214,9 @@ FIT_DEFINITION = ("<p>fit % = 100·(1 − ‖y − ŷ‖ / ‖y − ȳ‖), y me
 
 def write_validation_report(validation: Validation, folder: Path, title: str) -> Path:
     """The validation page ``folder/index.html`` with its figures, all or nothing
-    (:func:`~landing_gear_sim.report.pages.staged`); returns the page."""
-    with staged(folder) as stage:
-        write_html(stage / PAGE_FILE, title, _validation_sections(validation, stage),
-                   first_screen=3)
-    return folder / PAGE_FILE
+    (:func:`~landing_gear_sim.report.pages.write_report`); returns the page."""
+    return write_report(folder, title, lambda stage: _validation_sections(validation, stage),
+                        first_screen=3)
 
 
 def _validation_sections(validation: Validation, folder: Path) -> list[tuple[str, str]]:

@@ -442,6 +442,16 @@ def test_figures_laid_out_by_fixed_margins_keep_every_label_inside_and_apart(
     assert [_laid_out_within(fig) for fig in saved] == [[], [], []]
 
 
+def _stops(reference, *bars: float) -> list:
+    """Constant-pressure stops of the reference rig at ``bars``, named ``stop_<i>`` in order:
+    the same names, other figures, from one set of pressures to another."""
+    from landing_gear_sim.model import scenario as sc
+    from landing_gear_sim.model.integrate import simulate
+
+    return [dataclasses.replace(simulate(reference, sc.constant_pressure_test(
+        reference, bar * 1e5)).to_run(1), name=f"stop_{i}") for i, bar in enumerate(bars)]
+
+
 def _two_stops(reference, *bars: float):
     """A diagnosis of two constant-pressure stops (``bars``), each its own overlay and
     residual spectrum: a page of 5 figures, drawn without diagnosing anything."""
@@ -449,20 +459,13 @@ def _two_stops(reference, *bars: float):
     from landing_gear_sim.diagnosis.diagnose import Diagnosis
     from landing_gear_sim.diagnosis.residuals import spectrum
     from landing_gear_sim.diagnosis.signatures import RunEvidence
-    from landing_gear_sim.model import scenario as sc
-    from landing_gear_sim.model.integrate import simulate
-
-    def evidence(bar: float) -> RunEvidence:
-        run = dataclasses.replace(  # the same names, other figures, on each page
-            simulate(reference, sc.constant_pressure_test(reference, bar * 1e5)).to_run(1),
-            name=f"stop_{bars.index(bar)}")
-        return RunEvidence(classified(run), run, run, "pressure_pa",
-                           spectrum(run.pressure_pa - run.pressure_pa.mean(), 1000.0))
 
     return Diagnosis(verdict="none", findings=[], candidates=[], baseline={},
                      start=reference, calibrated=reference, extended=reference,
                      signatures_before=[], signatures_after=[],
-                     evidence=[evidence(bar) for bar in bars])
+                     evidence=[RunEvidence(classified(run), run, run, "pressure_pa", spectrum(
+                         run.pressure_pa - run.pressure_pa.mean(), 1000.0))
+                         for run in _stops(reference, *bars)])
 
 
 def test_a_page_drawn_side_by_side_is_the_page_drawn_on_one_core(reference, tmp_path,
@@ -539,13 +542,9 @@ def _on_one_and_on_two_cores(write, tmp_path, monkeypatch) -> dict[int, dict[str
 def test_a_validation_page_drawn_side_by_side_is_the_one_drawn_on_one_core(reference, tmp_path,
                                                                            monkeypatch):
     from landing_gear_sim.calibration.validate import validate_campaign
-    from landing_gear_sim.model import scenario as sc
-    from landing_gear_sim.model.integrate import simulate
     from landing_gear_sim.report.validation import write_validation_report
 
-    runs = [simulate(reference, sc.constant_pressure_test(reference, bar * 1e5)).to_run(1)
-            for bar in (20, 30)]
-    validation = validate_campaign(runs, reference)
+    validation = validate_campaign(_stops(reference, 20, 30), reference)
     pages = _on_one_and_on_two_cores(
         lambda folder: write_validation_report(validation, folder, "validation"), tmp_path,
         monkeypatch)
@@ -555,19 +554,14 @@ def test_a_validation_page_drawn_side_by_side_is_the_one_drawn_on_one_core(refer
 def test_a_validation_page_stopped_midway_leaves_the_page_before_it_as_it_was(
         reference, tmp_path, monkeypatch):
     from landing_gear_sim.calibration.validate import validate_campaign
-    from landing_gear_sim.model import scenario as sc
-    from landing_gear_sim.model.integrate import simulate
     from landing_gear_sim.report import validation as page
 
-    def validation(*bars: float):
-        runs = [dataclasses.replace(simulate(reference, sc.constant_pressure_test(
-            reference, bar * 1e5)).to_run(1), name=f"stop_{i}") for i, bar in enumerate(bars)]
-        return validate_campaign(runs, reference)
-
     folder = tmp_path / "report"
-    page.write_validation_report(validation(20, 30), folder, "before")
+    page.write_validation_report(validate_campaign(_stops(reference, 20, 30), reference), folder,
+                                 "before")
     before = _files(folder)
     _stopped_at(monkeypatch, page, "plot_overlay")
     with pytest.raises(KeyboardInterrupt):
-        page.write_validation_report(validation(25, 35), folder, "after")
+        page.write_validation_report(validate_campaign(_stops(reference, 25, 35), reference),
+                                     folder, "after")
     assert _files(folder) == before and len(before) == 4

@@ -4,11 +4,20 @@ of the stated uncertainty over hidden rigs made by the project's own generator.
 Run: ``make bench`` (or ``python bench/identify.py [N_RIGS]``). If the example campaigns of
 ``../shared/data`` are present they are identified too and compared with their generating
 parameters (the product itself never reads those).
+
+``python bench/identify.py --against DIR`` (the code before, a ``git worktree``): each
+campaign of ``../shared/data`` (v1, v2 and the independent ones) identified by the code now
+and before, each in a fresh interpreter of its checkout (compiled code loaded before the
+clock starts), one after the other: the time before over the time now, and whether every
+estimate and its σ are the same to the bit.
 """
 
 from __future__ import annotations
 
+import argparse
 import json
+import os
+import subprocess
 import sys
 import tempfile
 import time
@@ -24,7 +33,8 @@ from msg_tools.io import read_campaign
 
 TARGET_S = 60.0
 TARGET_REL = 0.05
-SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+HERE = Path(__file__).resolve().parents[1]
+SHARED = HERE.parent / "shared" / "data"
 SHARED_KEYS = {  # generating-parameters.json name -> our key (and unit factor)
     "flywheel_inertia": ("flywheel.inertia_kg_m2", 1.0), "drag_coeff": ("drag.coeff_n_s2_per_m2",
                                                                         1.0),
@@ -89,6 +99,65 @@ def shared_campaigns() -> None:
         print(f"   oscillating runs: {_oscillating_fits(campaign.runs, result.params)}")
 
 
-if __name__ == "__main__":
-    hidden_rigs(int(sys.argv[1]) if len(sys.argv) > 1 else 8)
+# what a fresh interpreter of a checkout measures (the API it uses is the same before)
+MEASURE = """
+import hashlib, json, sys, time
+from pathlib import Path
+from landing_gear_sim.calibration.identify import identify
+from landing_gear_sim.calibration.measured import simulate_all
+from landing_gear_sim.model.parameters import load_parameters
+from msg_tools.io import read_campaign
+runs, base = read_campaign(Path(sys.argv[1])).runs, load_parameters()
+simulate_all(runs, base)  # the compiled code loaded from its cache
+start = time.perf_counter()
+result = identify(runs, base)
+elapsed = time.perf_counter() - start
+estimates = repr([(e.key, e.value, e.std) for e in result.estimates]).encode()
+print(json.dumps({"checkout": str(Path(identify.__code__.co_filename).resolve().parents[2]),
+                  "seconds": elapsed, "estimates": hashlib.blake2b(estimates).hexdigest()}))
+"""
+
+
+def _measure(checkout: Path, folder: Path) -> dict:
+    """One identification of ``folder`` by ``checkout``'s code in a fresh interpreter."""
+    done = subprocess.run([sys.executable, "-c", MEASURE, str(folder)],
+                          env=dict(os.environ, PYTHONPATH=str(checkout)), check=True,
+                          capture_output=True, text=True, cwd=tempfile.gettempdir())
+    measured = json.loads(done.stdout.strip().splitlines()[-1])
+    if Path(measured["checkout"]) != checkout.resolve():
+        raise SystemExit(f"bench/identify.py: error: {checkout} is not a checkout of the "
+                         f"package: the code measured was {measured['checkout']}'s")
+    return measured
+
+
+def against(before: Path) -> None:
+    folders = [SHARED / "campaign_v1", SHARED / "campaign_v2",
+               *sorted(p for p in (SHARED / "independent").glob("I*") if p.is_dir())]
+    print("identify now and before (fresh interpreters): seconds, before over now, estimates")
+    ratios = []
+    for folder in (f for f in folders if f.is_dir()):
+        now, then = _measure(HERE, folder), _measure(before, folder)
+        ratios.append(then["seconds"] / now["seconds"])
+        same = "same" if now["estimates"] == then["estimates"] else "DIFFER"
+        print(f"{folder.name:22s} now {now['seconds']:5.1f} s  before {then['seconds']:5.1f} s"
+              f"  {ratios[-1]:4.2f}x faster  estimates {same}", flush=True)
+    if ratios:
+        print(f"median {np.median(ratios):.2f}x faster over {len(ratios)} campaigns")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("rigs", type=int, nargs="?", default=8, help="hidden rigs (default 8)")
+    parser.add_argument("--against", type=Path, help="the code before (a checkout)")
+    args = parser.parse_args()
+    if args.against:
+        if not (args.against / "landing_gear_sim" / "__init__.py").is_file():
+            parser.error(f"--against: {args.against} is not a checkout of the package")
+        against(args.against)
+        return
+    hidden_rigs(args.rigs)
     shared_campaigns()
+
+
+if __name__ == "__main__":
+    main()

@@ -171,7 +171,8 @@ def refine_friction(runs: Sequence[ClassifiedRun], p: RigParameters, jackknife: 
             "slip: add oscillating runs, or keep ϑ3 with --fix-theta3)")
     std = covariance_std(fit, 3)
     if jackknife:
-        std = np.maximum(std, _jackknife_std(residuals, derivatives, fit.x, len(runs)))
+        std = np.maximum(std, _jackknife_std(residuals, derivatives, fit,
+                                             [problem.samples(i) for i in every]))
     names = tuple(r.name for r in runs)
     method = "output error on wheel vs flywheel speed; σ: max(residual, jackknife)" + (
         f" (stopped at its budget of {REFINE_ITERATIONS} steps)" if fit.status == 0 else "")
@@ -211,6 +212,10 @@ class _Refinement:
         flywheel = simulated.flywheel_speed_rad_s[window] - run.flywheel_speed_rad_s[window]
         return self.weights[i] * (wheel - self.ratio * flywheel)[::5]
 
+    def samples(self, i: int) -> int:
+        """How many samples run i's error has (:meth:`slip_error`'s every fifth)."""
+        return len(range(0, int(np.count_nonzero(self.windows[i])), 5))
+
     def residuals(self, thetas: Sequence[np.ndarray], chosen: Sequence[int]
                   ) -> list[np.ndarray]:
         """Each ϑ's error over the ``chosen`` runs, every (ϑ, run) simulated side by side
@@ -238,11 +243,13 @@ class _Refinement:
 
 
 def _least_squares(residuals: Callable[[Sequence[np.ndarray]], list[np.ndarray]],
-                   derivatives: Derivatives, start: np.ndarray, iterations: int | None = None
+                   derivatives: Derivatives, start: np.ndarray, iterations: int | None = None,
+                   known: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
                    ) -> OptimizeResult:
     """The refinement's least squares within REFINE_BOUNDS, at most ``iterations`` steps
-    (on the plant's own derivatives where differences.MODEL_DERIVATIVES is on)."""
-    objective = Objective(residuals, *REFINE_BOUNDS, derivatives=derivatives)
+    (on the plant's own derivatives where differences.MODEL_DERIVATIVES is on); ``known``:
+    the residual and Jacobian at ``start``, already computed."""
+    objective = Objective(residuals, *REFINE_BOUNDS, known=known, derivatives=derivatives)
     return least_squares(objective.fun, start, jac=objective.jac, bounds=REFINE_BOUNDS,
                          ftol=negligible_gain(objective.fun(start)), max_nfev=iterations)
 
@@ -251,15 +258,26 @@ def _jackknife_std(residuals: Callable[[Sequence[np.ndarray], Sequence[int]],
                                        list[np.ndarray]],
                    derivatives: Callable[[np.ndarray, Sequence[int]],
                                          tuple[np.ndarray, np.ndarray] | None],
-                   solution: np.ndarray, n_runs: int) -> np.ndarray:
-    """Leave-one-run-out spread of the fit: run-to-run variability the residuals hide."""
+                   fit: OptimizeResult, samples: Sequence[int]) -> np.ndarray:
+    """Leave-one-run-out spread of ``fit`` (whose runs' errors have ``samples`` each, in
+    order): run-to-run variability the residuals hide. Each fit leaving a run out starts
+    at ``fit``'s optimum with its residual and Jacobian there, the other runs' rows: each
+    run's rows are its own simulations' (a Jacobian of fewer runs is those rows, to the
+    bit), so the four of its first ~14 simulations of each run are not made again."""
+    n_runs = len(samples)
     if n_runs < 3:
-        return np.zeros_like(solution)
+        return np.zeros_like(fit.x)
+    value, jacobian = np.split(fit.fun, np.cumsum(samples)[:-1]), np.split(
+        fit.jac, np.cumsum(samples)[:-1])
 
     def leaving_out(i: int) -> OptimizeResult:
         chosen = [j for j in range(n_runs) if j != i]
+        # in the layout the Jacobian of these runs has (Objective.jac's): the solver's
+        # rounding follows it
+        known = (fit.x, np.concatenate([value[j] for j in chosen]),
+                 np.asfortranarray(np.concatenate([jacobian[j] for j in chosen])))
         return _least_squares(lambda thetas: residuals(thetas, chosen),
-                              lambda theta: derivatives(theta, chosen), solution)
+                              lambda theta: derivatives(theta, chosen), fit.x, known=known)
 
     fits = [leaving_out(i).x for i in range(n_runs)]
     spread = np.asarray(fits) - np.mean(fits, axis=0)

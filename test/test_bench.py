@@ -39,3 +39,11 @@ def test_the_diagnosis_bench_refuses_code_before_that_is_no_checkout(tmp_path):
                            str(tmp_path)], capture_output=True, text=True, timeout=120)
     assert done.returncode == 2, done.stderr
     assert f"{tmp_path} is not a checkout of the package" in done.stderr
+
+
+def test_the_identification_bench_refuses_code_before_that_is_no_checkout(tmp_path):
+    """As the diagnosis bench: "before" measured from no checkout would be the code now."""
+    done = subprocess.run([sys.executable, str(ROOT / "bench" / "identify.py"), "--against",
+                           str(tmp_path)], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2, done.stderr
+    assert f"{tmp_path} is not a checkout of the package" in done.stderr

@@ -261,9 +261,10 @@ def _jackknife_std(residuals: Callable[[Sequence[np.ndarray], Sequence[int]],
                    fit: OptimizeResult, samples: Sequence[int]) -> np.ndarray:
     """Leave-one-run-out spread of ``fit`` (whose runs' errors have ``samples`` each, in
     order): run-to-run variability the residuals hide. Each fit leaving a run out starts
-    at ``fit``'s optimum with its residual and Jacobian there, the other runs' rows: each
-    run's rows are its own simulations' (a Jacobian of fewer runs is those rows, to the
-    bit), so the four of its first ~14 simulations of each run are not made again."""
+    at ``fit``'s optimum, with ``fit``'s residual and Jacobian rows of the runs it keeps:
+    a run's rows are its own simulations', so they are that fit's residual and Jacobian
+    there to the bit, and its start and the start's three columns (4 of its ~14
+    simulations of each run) are not simulated again."""
     n_runs = len(samples)
     if n_runs < 3:
         return np.zeros_like(fit.x)

@@ -138,6 +138,15 @@ def _wait_for(condition, timeout_s: float, what: str) -> None:
         time.sleep(0.1)
 
 
+def _scheduler_address(path: Path) -> str | None:
+    """The address in a scheduler's file, None until it is written whole (the scheduler
+    writes it in place: read as soon as it existed, it was once empty)."""
+    try:
+        return json.loads(path.read_text())["address"]
+    except (FileNotFoundError, json.JSONDecodeError, KeyError):
+        return None
+
+
 @pytest.mark.long
 def test_a_worker_killed_mid_run_loses_nothing(history, identified_history, tmp_path):
     """A real `dask scheduler` and two `dask worker` processes on 127.0.0.1; one worker is
@@ -148,8 +157,8 @@ def test_a_worker_killed_mid_run_loses_nothing(history, identified_history, tmp_
     processes = [_dask("dask_scheduler", "--host", "127.0.0.1", "--port", "0",
                        "--no-dashboard", "--scheduler-file", str(address_file))]
     try:
-        _wait_for(address_file.exists, 60, "the scheduler")
-        address = json.loads(address_file.read_text())["address"]
+        _wait_for(lambda: _scheduler_address(address_file), 60, "the scheduler")
+        address = _scheduler_address(address_file)
         processes += [_dask("dask_worker", address, "--nthreads", "1", "--no-nanny",
                             "--no-dashboard", "--host", "127.0.0.1") for _ in range(2)]
         out = tmp_path / "cluster"

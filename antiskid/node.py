@@ -15,7 +15,7 @@ from dataclasses import fields
 
 from sensor_msgs.msg import JointState
 
-from landing_gear_sim.model.blocks import step_time
+from landing_gear_sim.model.scenario import step_time
 from landing_gear_sim.ros.nodes.graph_node import GraphNode, main_for
 from landing_gear_sim.ros.nodes.handshake import Handshake, announce_ready
 from landing_gear_sim.ros.nodes.parameters import declare, rig_and_run

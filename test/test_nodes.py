@@ -538,3 +538,15 @@ def test_a_stop_by_a_signal_joins_the_bag_only_while_that_is_quick():
     assert joins_on_close(stopped=False, messages=1_500_000)
     assert joins_on_close(stopped=True, messages=JOIN_ON_STOP_MESSAGES)
     assert not joins_on_close(stopped=True, messages=JOIN_ON_STOP_MESSAGES + 1)
+
+
+def test_the_profile_node_starts_without_the_compiled_model():
+    """It publishes a current profile and stamps its steps: numba and scipy's linear algebra
+    are the plant's and the valve's to load (they had been 0.4 of its 0.7 s import, in
+    every graph run, through the steps' clock)."""
+    code = ("import sys; import landing_gear_sim.ros.nodes.profile; "
+            "print(sorted({m for m in sys.modules} & {'numba', 'scipy.linalg'}))")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            cwd=Path(__file__).resolve().parents[1], check=False)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "[]"

@@ -15,7 +15,7 @@ import numpy as np
 
 from landing_gear_sim.model import actuator, plant, quantities
 from landing_gear_sim.model.parameters import RigParameters
-from landing_gear_sim.model.scenario import Scenario
+from landing_gear_sim.model.scenario import Scenario, step_time
 from landing_gear_sim.model.sensors import SensorModel, late
 
 
@@ -30,11 +30,6 @@ class SensorSample:
     flywheel_speed_rad_s: float
     vertical_load_n: float
     longitudinal_force_n: float
-
-
-def step_time(step: int, step_s: float) -> float:
-    """Time of exchange step ``step`` [s], computed as the offline run does."""
-    return step * step_s
 
 
 class ActuatorBlock:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from builtin_interfaces.msg import Time
 
-from landing_gear_sim.model.blocks import step_time
+from landing_gear_sim.model.scenario import step_time
 
 
 def to_stamp(time_s: float) -> Time:

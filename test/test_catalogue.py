@@ -30,7 +30,8 @@ def test_actuator_delay_is_recovered_within_a_millisecond(reference, tmp_path, s
     runs, rig = _hidden(reference, tmp_path, seed, lambda rng: {
         "elements.actuator_delay": True, "actuator.delay_s": rng.uniform(0.002, 0.02)},
         ACTUATOR_RUNS)
-    fit = fit_candidate(CATALOGUE["actuator_delay"], runs, identify(runs, reference).params)
+    fit = fit_candidate(CATALOGUE["actuator_delay"], runs,
+                        identify(runs, reference, jackknife=False).params)
     assert fit.values["actuator.delay_s"] == pytest.approx(rig.number("actuator.delay_s"),
                                                            abs=1e-3), seed
     assert fit.values["actuator.natural_frequency_hz"] == pytest.approx(
@@ -43,7 +44,7 @@ def test_pressure_sensor_offset_is_recovered_within_20_percent(reference, tmp_pa
         "sensors.pressure_offset_pa": rng.choice([-1, 1]) * rng.uniform(0.3e5, 1.5e5)},
         ACTUATOR_RUNS)
     fit = fit_candidate(CATALOGUE["pressure_sensor_offset"], runs,
-                        identify(runs, reference).params)
+                        identify(runs, reference, jackknife=False).params)
     assert fit.values["sensors.pressure_offset_pa"] == pytest.approx(
         rig.number("sensors.pressure_offset_pa"), rel=0.2)
 
@@ -53,7 +54,7 @@ def test_gear_walk_is_rediscovered_from_a_model_without_it(reference, tmp_path):
     runs, rig = _hidden(reference, tmp_path, 25, lambda rng: {
         "gear_walk.stiffness_n_m_per_rad": 6.9e5 * rng.uniform(0.7, 1.4)},
         ACTUATOR_RUNS + BRAKING_RUNS)
-    start = identify(runs, reference.without("gear_walk")).params
+    start = identify(runs, reference.without("gear_walk"), jackknife=False).params
     fit = fit_candidate(CATALOGUE["gear_walk"], runs, start, datasheet=reference)
     found, truth = gear_walk_key_parameters(fit.params), gear_walk_key_parameters(rig)
     assert found["frequency_hz"] == pytest.approx(truth["frequency_hz"], rel=0.05)
@@ -62,7 +63,7 @@ def test_gear_walk_is_rediscovered_from_a_model_without_it(reference, tmp_path):
 def test_the_right_candidate_explains_more_than_a_wrong_one(reference, tmp_path):
     runs, _ = _hidden(reference, tmp_path, 26, lambda rng: {
         "elements.actuator_delay": True, "actuator.delay_s": 0.008}, ACTUATOR_RUNS)
-    calibrated = identify(runs, reference).params
+    calibrated = identify(runs, reference, jackknife=False).params
     right = fit_candidate(CATALOGUE["actuator_delay"], runs, calibrated)
     wrong = fit_candidate(CATALOGUE["pressure_sensor_offset"], runs, calibrated)
     assert right.cost < 0.5 * wrong.cost
@@ -236,7 +237,7 @@ def test_a_fit_simulates_its_start_once(reference, tmp_path, monkeypatch):
     pass the plain one cannot stand for) at most once."""
     runs, _ = _hidden(reference, tmp_path, 26, lambda rng: {
         "elements.actuator_delay": True, "actuator.delay_s": 0.008}, ACTUATOR_RUNS)
-    calibrated = identify(runs, reference).params
+    calibrated = identify(runs, reference, jackknife=False).params
     simulated = _counting(monkeypatch)
     fit_candidate(CATALOGUE["actuator_delay"], runs, calibrated)
     assert len(set(simulated)) == len(simulated) > 8
@@ -249,7 +250,7 @@ def test_a_start_both_references_give_is_simulated_and_probed_once(reference, tm
     quarter of a discovered term's simulations (issue 61: nothing computed twice)."""
     runs, _ = _hidden(reference, tmp_path, 26, lambda rng: {
         "elements.actuator_delay": True, "actuator.delay_s": 0.008}, ACTUATOR_RUNS)
-    calibrated = identify(runs, reference).params
+    calibrated = identify(runs, reference, jackknife=False).params
     simulated = _counting(monkeypatch)
     fit = fit_candidate(CATALOGUE["actuator_delay"], runs, calibrated, datasheet=calibrated)
     assert len(set(simulated)) == len(simulated) > 8
@@ -263,7 +264,7 @@ def test_a_candidate_tried_again_starts_where_it_ended(reference, tmp_path, monk
     fewer simulations."""
     runs, _ = _hidden(reference, tmp_path, 26, lambda rng: {
         "elements.actuator_delay": True, "actuator.delay_s": 0.008}, ACTUATOR_RUNS)
-    calibrated = identify(runs, reference).params
+    calibrated = identify(runs, reference, jackknife=False).params
     simulated = _counting(monkeypatch)
     first = fit_candidate(CATALOGUE["actuator_delay"], runs, calibrated)
     cold = len(simulated)
@@ -282,7 +283,7 @@ def test_a_fit_that_stops_on_its_budget_says_so_in_the_candidates_reason(
 
     runs, _ = _hidden(reference, tmp_path, 26, lambda rng: {
         "elements.actuator_delay": True, "actuator.delay_s": 0.008}, ACTUATOR_RUNS)
-    calibrated = identify(runs, reference).params
+    calibrated = identify(runs, reference, jackknife=False).params
     assert not fit_candidate(CATALOGUE["actuator_delay"], runs, calibrated).stopped
     monkeypatch.setattr(catalogue, "MAX_ITERATIONS", 2)
     stopped = fit_candidate(CATALOGUE["actuator_delay"], runs, calibrated)

@@ -291,7 +291,7 @@ def test_a_fit_on_the_plants_derivatives_reaches_the_differences_optimum_in_fewe
         {"elements.actuator_delay": True, K.ACTUATOR_DELAY_S: 0.008})
     generate_campaign(tmp_path, rig, 26, ["actuator_ramp", "actuator_steps_sweep"])
     runs = read_campaign(tmp_path).runs
-    calibrated = identify(runs, reference).params
+    calibrated = identify(runs, reference, jackknife=False).params
     passes = {"plain": 0, "dual": 0}
     plain, dual = catalogue.scaled_residuals, catalogue.scaled_residuals_and_jacobian
 

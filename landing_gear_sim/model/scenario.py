@@ -23,9 +23,10 @@ from msg_tools.units import PA_PER_BAR
 
 def step_time(step: int, step_s: float) -> float:
     """Time of exchange step ``step`` [s], computed as the offline run does (here, not
-    beside the blocks: the profile's and the controller's nodes stamp steps without loading
-    the compiled model)."""
+    beside the blocks: the profile node stamps its steps without loading the compiled
+    model)."""
     return step * step_s
+
 
 Profile = Callable[[np.ndarray], np.ndarray]
 """Current reference [A] as a function of time since the profile started [s], shapes (n,)."""

@@ -24,14 +24,11 @@ printed over the quiet one: campaign_v1 ≤ 2.5× its quiet time beside two.
 from __future__ import annotations
 
 import argparse
-import json
-import os
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
+from checkouts import is_checkout, measured_in
 from stopping import busy_loops  # the same load as the stopping bench's
 
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
@@ -109,18 +106,8 @@ print(json.dumps({"checkout": str(Path(diagnose.__code__.co_filename).resolve().
 
 def _measure(checkout: Path, folder: Path, without: tuple[str, ...]) -> dict:
     """One diagnosis of ``folder`` by ``checkout``'s code in a fresh interpreter."""
-    env = dict(os.environ, PYTHONPATH=str(checkout))
-    # not from a checkout's folder: `python -c` puts its folder first on the path
-    done = subprocess.run([sys.executable, "-c", MEASURE, str(folder), ",".join(without)],
-                          env=env, check=True, capture_output=True, text=True,
-                          cwd=tempfile.gettempdir())
-    measured = json.loads(done.stdout.strip().splitlines()[-1])
-    if Path(measured["checkout"]) != checkout.resolve():
-        # PYTHONPATH names no checkout (a worktree not made, a typo): the editable install
-        # gave the main checkout's code, and "before" had measured the code now
-        raise SystemExit(f"bench/diagnose.py: error: {checkout} is not a checkout of the "
-                         f"package: the diagnosis measured was {measured['checkout']}'s")
-    return measured
+    return measured_in(checkout, MEASURE, str(folder), ",".join(without),
+                       bench="bench/diagnose.py")
 
 
 def _row(name: str, folder: Path, without: tuple[str, ...], before: Path | None,
@@ -159,7 +146,7 @@ def main() -> None:
                         help=f"diagnose each campaign again beside N busy loops (campaign_v1 "
                              f"beside 2: ≤ {TARGET_LOADED:g}x its quiet time)")
     args = parser.parse_args()
-    if args.against and not (args.against / "landing_gear_sim" / "__init__.py").is_file():
+    if args.against and not is_checkout(args.against):
         parser.error(f"--against: {args.against} is not a checkout of the package")
     print("diagnose on full campaigns: time, passes (time over one simulation pass) and "
           "the passes' ratio to the target (> 1 beats it), peak memory, the runs simulated "

@@ -16,14 +16,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+from checkouts import is_checkout, measured_in
 
 from landing_gear_sim.calibration.campaign import DEVIATING, generate_campaign, rig_like
 from landing_gear_sim.calibration.identify import identify
@@ -120,14 +118,7 @@ print(json.dumps({"checkout": str(Path(identify.__code__.co_filename).resolve().
 
 def _measure(checkout: Path, folder: Path) -> dict:
     """One identification of ``folder`` by ``checkout``'s code in a fresh interpreter."""
-    done = subprocess.run([sys.executable, "-c", MEASURE, str(folder)],
-                          env=dict(os.environ, PYTHONPATH=str(checkout)), check=True,
-                          capture_output=True, text=True, cwd=tempfile.gettempdir())
-    measured = json.loads(done.stdout.strip().splitlines()[-1])
-    if Path(measured["checkout"]) != checkout.resolve():
-        raise SystemExit(f"bench/identify.py: error: {checkout} is not a checkout of the "
-                         f"package: the code measured was {measured['checkout']}'s")
-    return measured
+    return measured_in(checkout, MEASURE, str(folder), bench="bench/identify.py")
 
 
 def against(before: Path) -> None:
@@ -151,7 +142,7 @@ def main() -> None:
     parser.add_argument("--against", type=Path, help="the code before (a checkout)")
     args = parser.parse_args()
     if args.against:
-        if not (args.against / "landing_gear_sim" / "__init__.py").is_file():
+        if not is_checkout(args.against):
             parser.error(f"--against: {args.against} is not a checkout of the package")
         against(args.against)
         return

@@ -526,6 +526,35 @@ def test_a_page_written_again_whole_replaces_every_file_it_draws(reference, tmp_
     assert _files(folder) == _files(apart) and len(_files(apart)) == 6
 
 
+def test_a_page_written_again_for_fewer_runs_keeps_no_figure_of_the_runs_it_lost(reference,
+                                                                               tmp_path):
+    """A report folder used again (the same command after the campaign changed): the
+    figures of a run the new page no longer shows are gone, so that the folder sent on is
+    the page's alone; a file the user put beside them stays."""
+    from landing_gear_sim.report.diagnosis import write_diagnosis_report
+
+    folder, apart = tmp_path / "report", tmp_path / "apart"
+    write_diagnosis_report(_two_stops(reference, 20, 30, 40), folder)
+    assert {"stop_2.png", "stop_2_spectrum.png"} <= set(_files(folder))
+    (folder / "notes.txt").write_text("the rig's log book")
+    write_diagnosis_report(_two_stops(reference, 25, 35), folder)
+    write_diagnosis_report(_two_stops(reference, 25, 35), apart)
+    assert _files(folder) == {**_files(apart), "notes.txt": b"the rig's log book"}
+
+
+def test_a_page_written_over_another_removes_nothing_outside_its_folder(reference, tmp_path):
+    """The page before it names what its folder held, never what lies outside it."""
+    from landing_gear_sim.report.diagnosis import write_diagnosis_report
+
+    folder, outside, absolute = tmp_path / "report", tmp_path / "a.png", tmp_path / "b.png"
+    folder.mkdir()
+    for path in (outside, absolute):
+        path.write_bytes(b"not the page's")
+    (folder / "index.html").write_text(f"<img src='../a.png'><img src='{absolute}'>")
+    write_diagnosis_report(_two_stops(reference, 20), folder)
+    assert outside.exists() and absolute.exists()
+
+
 def _on_one_and_on_two_cores(write, tmp_path, monkeypatch) -> dict[int, dict[str, bytes]]:
     """The files ``write`` writes into a folder, on one core and on two."""
     import os

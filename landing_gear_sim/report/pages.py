@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import html
+import re
 import shutil
 import tempfile
 from collections.abc import Callable, Iterator, Sequence
@@ -66,20 +67,38 @@ def staged(folder: Path) -> Iterator[Path]:
     ``folder``, the page last. A report stopped midway (Ctrl-C, SIGTERM, an error) had left
     the page before it beside the new figures drawn so far, which it showed as its own:
     now that report stays as it was, and nothing of the new one is left. The stage is a
-    hidden folder inside ``folder``, on its file system: each move is a rename."""
+    hidden folder inside ``folder``, on its file system: each move is a rename. Then the
+    figures the page before it showed and this one does not are removed (:func:`shown`):
+    a folder used again had kept the figures of runs its campaign no longer had."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
+    before = shown(folder / PAGE_FILE)
     stage = Path(tempfile.mkdtemp(prefix=".writing-", dir=folder))
     try:
         yield stage
-        written = sorted((path for path in stage.rglob("*") if path.is_file()),
-                         key=lambda path: path.relative_to(stage) == Path(PAGE_FILE))
-        for path in written:
-            target = folder / path.relative_to(stage)
-            target.parent.mkdir(parents=True, exist_ok=True)
-            path.replace(target)
+        written = sorted((path.relative_to(stage) for path in stage.rglob("*")
+                          if path.is_file()), key=lambda name: name == Path(PAGE_FILE))
+        for name in written:
+            (folder / name).parent.mkdir(parents=True, exist_ok=True)
+            (stage / name).replace(folder / name)
+        for name in before - set(written):
+            if (folder / name).is_file():
+                (folder / name).unlink()
     finally:
         shutil.rmtree(stage, ignore_errors=True)
+
+
+def shown(page: Path) -> set[Path]:
+    """The figures ``page`` shows (:func:`html_image`), as paths in its folder; only those
+    inside it (a page is ours, but its folder may hold anything)."""
+    try:
+        text = page.read_text(errors="replace")
+    except OSError:  # no page yet
+        return set()
+    folder = page.parent.resolve()
+    names = {Path(html.unescape(src)) for src in re.findall(r"<img src='([^']*)'>", text)}
+    return {name for name in names if not name.is_absolute()
+            and (folder / name).resolve().is_relative_to(folder)}
 
 
 def _anchor(heading: str) -> str:

@@ -24,6 +24,7 @@ from .contract import (
 )
 from .errors import RunFormatError
 from .run import Run
+from .stamps import ns_of_time, stamp_fields
 
 TYPESTORE = get_typestore(Stores.ROS2_KILTED)
 BAG_VERSION: Literal[9] = 9
@@ -31,9 +32,7 @@ STORAGE = {"mcap": StoragePlugin.MCAP, "sqlite3": StoragePlugin.SQLITE3}
 
 
 def _stamp(time_s: float) -> Any:
-    nanoseconds = round(time_s * 1e9)
-    time_type = TYPESTORE.types["builtin_interfaces/msg/Time"]
-    return time_type(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
+    return TYPESTORE.types["builtin_interfaces/msg/Time"](**stamp_fields(ns_of_time(time_s)))
 
 
 def _header(time_s: float, frame: str) -> Any:
@@ -92,7 +91,7 @@ def write_bag(run: Run, path: Path, storage: str = "mcap") -> None:
         connections = {topic: writer.add_connection(topic, msgtype, typestore=TYPESTORE)
                        for topic, msgtype in TOPIC_TYPES.items()}
         for k in range(len(run)):
-            log_time = round(float(run.time_s[k]) * 1e9)
+            log_time = ns_of_time(float(run.time_s[k]))
             for topic, message in contract_messages(run, k).items():
                 data = TYPESTORE.serialize_cdr(message, TOPIC_TYPES[topic])
                 writer.write(connections[topic], log_time, data)

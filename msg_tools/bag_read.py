@@ -28,6 +28,7 @@ from .derivative import speed_from_angle
 from .errors import RunFormatError
 from .mapping import DEFAULT_MAPPING, Mapping
 from .run import Run
+from .stamps import seconds_of_fields
 
 
 def bag_paths(path: Path) -> list[Path]:
@@ -160,7 +161,7 @@ def _stamp_s(message: Any, log_time_ns: int) -> tuple[float, bool]:
     """(the header stamp, True), or (the log time, False) for a message without one."""
     header = getattr(message, "header", None)
     if header is not None and (header.stamp.sec or header.stamp.nanosec):
-        return header.stamp.sec + header.stamp.nanosec * 1e-9, True
+        return seconds_of_fields(header.stamp.sec, header.stamp.nanosec), True
     return log_time_ns * 1e-9, False
 
 

@@ -5,18 +5,19 @@ from __future__ import annotations
 from builtin_interfaces.msg import Time
 
 from landing_gear_sim.model.scenario import step_time
+from msg_tools.stamps import ns_of_fields, ns_of_time, stamp_fields
 
 
 def to_stamp(time_s: float) -> Time:
-    return stamp_of_ns(round(time_s * 1e9))
+    return stamp_of_ns(ns_of_time(time_s))
 
 
 def stamp_of_ns(nanoseconds: int) -> Time:
-    return Time(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
+    return Time(**stamp_fields(nanoseconds))
 
 
 def ns_of(stamp: Time) -> int:
-    return stamp.sec * 1_000_000_000 + stamp.nanosec
+    return ns_of_fields(stamp.sec, stamp.nanosec)
 
 
 class RunClock:
@@ -42,5 +43,5 @@ class RunClock:
         return round((ns_of(stamp) - (self.origin_ns or 0)) * 1e-9 / self.step_s)
 
     def stamp(self, step: int) -> Time:
-        return stamp_of_ns((self.origin_ns or 0) + round(step_time(step, self.step_s) * 1e9))
+        return stamp_of_ns((self.origin_ns or 0) + ns_of_time(step_time(step, self.step_s)))
 

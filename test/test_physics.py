@@ -130,7 +130,9 @@ def test_stepping_the_blocks_one_by_one_equals_the_compiled_run(reference, conta
     p, h = reference.vector(), scenario.step_s
     matrices = actuator.actuator_matrices(p, h)
     expected = np.empty((current.size, plant.N_CHANNELS))
-    run_kernel(p, matrices, current, h, contact, speed_m_s, 0.0, np.zeros(0), expected)
+    # every argument given, as simulate gives them: a default left out is another signature
+    # to compile (~8 s in a suite that starts cold)
+    run_kernel(p, matrices, current, h, contact, speed_m_s, 0.0, np.zeros(0), expected, False)
 
     x, xa, xl = np.zeros(plant.N_STATES), actuator.actuator_state(matrices), np.zeros(1)
     x[plant.SPEED] = speed_m_s
@@ -162,6 +164,21 @@ def test_batch_accepts_one_input_per_set(reference):
     inputs = np.stack([np.full(1000, 0.3), np.full(1000, 0.6)])
     low, high = simulate_batch([reference, reference], scenario, inputs)
     assert low.pressure_pa[-1] < high.pressure_pa[-1]
+
+
+def test_inputs_of_any_kind_share_one_compiled_batch_kernel(reference):
+    """One set (a broadcast view of the scenario's current) and a caller's read-only inputs
+    run the batch kernel compiled for the rest: each had been another type to numba, and
+    compiled the parallel kernel again."""
+    from landing_gear_sim.model.integrate import batch_kernel
+
+    scenario = sc.actuator_test(reference, sc.constant(0.5), 0.2)
+    frozen = np.full((2, scenario.current_a.size), 0.4)
+    frozen.flags.writeable = False
+    simulate_batch([reference, reference], scenario)
+    simulate_batch([reference], scenario)
+    simulate_batch([reference, reference], scenario, frozen)
+    assert len(batch_kernel.signatures) == 1, batch_kernel.signatures
 
 
 def test_switched_off_elements_leave_no_trace(reference):

@@ -189,8 +189,10 @@ def simulate_batch(params: Sequence[RigParameters], scenario: Scenario,
     results: list[SimulationResult] = []
     for start in range(0, len(params), BATCH_CHUNK):
         chunk = list(params[start:start + BATCH_CHUNK])
+        # a fresh writable copy: numba compiles a read-only array (a broadcast view, a
+        # caller's frozen inputs) as another type, the parallel kernel once more (~10 s)
         results.extend(_simulate_chunk(chunk, scenario,
-                                       np.ascontiguousarray(inputs[start:start + len(chunk)])))
+                                       np.array(inputs[start:start + len(chunk)], order="C")))
     return results
 
 

@@ -35,19 +35,19 @@ def _stamp(time_s: float) -> Any:
     return TYPESTORE.types["builtin_interfaces/msg/Time"](**stamp_fields(ns_of_time(time_s)))
 
 
-def _header(time_s: float, frame: str) -> Any:
-    return TYPESTORE.types["std_msgs/msg/Header"](stamp=_stamp(time_s), frame_id=frame)
+def _header(stamp: Any, frame: str) -> Any:
+    return TYPESTORE.types["std_msgs/msg/Header"](stamp=stamp, frame_id=frame)
 
 
 def contract_messages(run: Run, k: int) -> dict[str, Any]:
     """The contract messages of sample ``k`` of ``run``, by topic."""
-    t = float(run.time_s[k])
+    stamp = _stamp(float(run.time_s[k]))  # one a sample: its five messages share it
     types = TYPESTORE.types
     empty = np.empty(0)
 
     def joint(name: str, speed: float) -> Any:
         return types["sensor_msgs/msg/JointState"](
-            header=_header(t, name), name=[name], position=empty,
+            header=_header(stamp, name), name=[name], position=empty,
             velocity=np.array([speed]), effort=empty)
 
     vector = types["geometry_msgs/msg/Vector3"]
@@ -56,15 +56,15 @@ def contract_messages(run: Run, k: int) -> dict[str, Any]:
         torque=vector(x=0.0, y=0.0, z=0.0))
     return {
         TOPIC_CURRENT: types["sensor_msgs/msg/JointState"](
-            header=_header(t, VALVE_JOINT), name=[VALVE_JOINT], position=empty, velocity=empty,
+            header=_header(stamp, VALVE_JOINT), name=[VALVE_JOINT], position=empty, velocity=empty,
             effort=np.array([float(run.current_a[k])])),
         TOPIC_PRESSURE: types["sensor_msgs/msg/FluidPressure"](
-            header=_header(t, "brake"), fluid_pressure=float(run.pressure_pa[k]) + ATMOSPHERE_PA,
-            variance=0.0),
+            header=_header(stamp, "brake"),
+            fluid_pressure=float(run.pressure_pa[k]) + ATMOSPHERE_PA, variance=0.0),
         TOPIC_WHEEL: joint("wheel", float(run.wheel_speed_rad_s[k])),
         TOPIC_FLYWHEEL: joint("flywheel", float(run.flywheel_speed_rad_s[k])),
         TOPIC_WRENCH: types["geometry_msgs/msg/WrenchStamped"](
-            header=_header(t, "load_cell"), wrench=wrench),
+            header=_header(stamp, "load_cell"), wrench=wrench),
     }
 
 

@@ -58,6 +58,12 @@ DISPLAY: dict[str, tuple[str, float]] = {
 }
 """SI unit -> the unit a brake engineer reads a term's value in, and the factor to it."""
 
+DISPLAY_UNITS: dict[str, tuple[float, str]] = {
+    "pressure_pa": (1 / PA_PER_BAR, "bar"), "wheel_speed_rad_s": (1.0, "rad/s"),
+    "flywheel_speed_rad_s": (1.0, "rad/s"), "vertical_load_n": (1e-3, "kN"),
+    "longitudinal_force_n": (1e-3, "kN")}
+"""Run channel (SI) → (factor, unit) its figures, tables and sentences show it in."""
+
 
 def display(value_si: float, unit: str, spec: str = ".4g") -> str:
     """``value_si`` [``unit``] as a brake engineer reads it, e.g. 0.0047 s -> '4.7 ms'

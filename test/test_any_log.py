@@ -23,7 +23,8 @@ from landing_gear_sim.model import scenario as sc
 from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import load_parameters
 from landing_gear_sim.model.runspec import build_scenario
-from landing_gear_sim.report.diagnosis import diagnosis_summary, write_diagnosis_report
+from landing_gear_sim.report.diagnosis import write_diagnosis_report
+from landing_gear_sim.report.summary import diagnosis_summary
 from msg_tools.csv_io import read_csv, write_csv
 from msg_tools.errors import RunFormatError
 from msg_tools.io import read_campaign, read_run

@@ -638,6 +638,25 @@ def test_actuator_runs_alone_name_the_delay_held_out_in_time(reference, delay_ca
     assert "tire_relaxation: not identifiable: no braking run" in _notes(result)
 
 
+def test_a_command_that_draws_nothing_loads_no_matplotlib(delay_campaign, tmp_path):
+    """Issue 61: `identify`, and `diagnose` without `--report`, print a table and a summary
+    but had imported the page's plotting (matplotlib, ~0.4 s of each start) with them."""
+    runs, _ = delay_campaign
+    for name in ("actuator_ramp", "actuator_steps_sweep"):
+        write_csv(runs[name], tmp_path / f"{name}.csv")
+    code = ("import sys; from landing_gear_sim.cli import main\n"
+            f"print(main(['identify', {str(tmp_path)!r}, '--partial', "
+            f"'-o', {str(tmp_path / 'p.yaml')!r}]))\n"
+            f"print(main(['diagnose', {str(tmp_path)!r}]))\n"
+            "print('matplotlib' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=300, check=False)
+    lines = done.stdout.splitlines()
+    assert lines.count("0") == 2 and "VERDICT: actuator_delay" in done.stdout, \
+        done.stdout + done.stderr
+    assert lines[-1] == "False", "matplotlib was loaded"
+
+
 def test_braking_runs_alone_claim_no_valve_effect_and_end(reference, delay_campaign):
     """Braking runs only once gave a 13.7 ms delay *and* an "unexplained lag −6.8 ms";
     with --without gear_walk the pressure_sensor_offset fit ran for over 25 minutes."""

@@ -40,7 +40,7 @@ from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.parameters import load_parameters
 from landing_gear_sim.model.scenario import constant_pressure_test
-from landing_gear_sim.report.validation import validation_sentence
+from landing_gear_sim.report.validation_tables import validation_sentence
 from msg_tools.csv_io import write_csv
 from msg_tools.io import read_campaign
 from msg_tools.units import PA_PER_BAR

@@ -328,7 +328,8 @@ def test_one_number_reads_one_value_on_the_page_and_in_the_terminal(reference, t
     labelled; ΔBIC and gains read the same everywhere."""
     from landing_gear_sim.diagnosis.diagnose import Diagnosis
     from landing_gear_sim.diagnosis.findings import Finding
-    from landing_gear_sim.report.diagnosis import diagnosis_sections, diagnosis_summary
+    from landing_gear_sim.report.diagnosis import diagnosis_sections
+    from landing_gear_sim.report.summary import diagnosis_summary
 
     def finding(value: float, round_: int) -> Finding:
         return Finding(cause="actuator_delay", parameters={"delay_s": value},

@@ -131,7 +131,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
     from landing_gear_sim.calibration.identify import identify
     from landing_gear_sim.report.pages import text_table
-    from landing_gear_sim.report.validation import estimates_table
+    from landing_gear_sim.report.validation_tables import estimates_table
     from msg_tools.io import read_campaign
 
     check_outputs(files=[args.output])
@@ -176,12 +176,12 @@ def _write_params(result: Identification, path: Path) -> None:
 def cmd_validate(args: argparse.Namespace) -> int:
     from landing_gear_sim.calibration.validate import channel_verdicts, validate_campaign
     from landing_gear_sim.report.pages import text_table
-    from landing_gear_sim.report.validation import (
+    from landing_gear_sim.report.validation import write_validation_report
+    from landing_gear_sim.report.validation_tables import (
         scores_header,
         scores_table,
         validation_sentence,
         verdict_table,
-        write_validation_report,
     )
     from msg_tools.io import read_campaign
 
@@ -205,9 +205,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
     from landing_gear_sim.calibration.plausibility import check_units
     from landing_gear_sim.calibration.runs import classified
     from landing_gear_sim.calibration.validate import NOISE_MULTIPLE, compare
-    from landing_gear_sim.report.figures import DISPLAY_UNITS
     from landing_gear_sim.report.pages import text_table
     from landing_gear_sim.report.validation import plot_overlay
+    from msg_tools.units import DISPLAY_UNITS
 
     check_outputs(files=[args.plot])
     measured = classified(read_one(args.measured, mapping_of(args)))  # once: compare keeps it
@@ -263,8 +263,8 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
     starting_model(base, args.start_without)  # a misspelt element: at once
 
     from landing_gear_sim.diagnosis.diagnose import diagnose
-    from landing_gear_sim.report.diagnosis import diagnosis_summary, write_diagnosis_report
     from landing_gear_sim.report.model_file import write_extended_model
+    from landing_gear_sim.report.summary import diagnosis_summary
     from msg_tools.io import read_runs
 
     campaign = read_runs(args.runs, mapping_of(args))
@@ -281,6 +281,9 @@ def cmd_diagnose(args: argparse.Namespace) -> int:
         print(f"json:   {args.json}")
     if args.report:
         progress("writing the report")
+        # the page's figures need matplotlib; the summary and the JSON do not
+        from landing_gear_sim.report.diagnosis import write_diagnosis_report
+
         page = write_diagnosis_report(result, args.report)
         print(f"report: {page}")
     if args.output:

@@ -20,30 +20,30 @@ import matplotlib.ticker
 import numpy as np
 
 from landing_gear_sim.calibration.measured import channel_words
-from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
+from landing_gear_sim.diagnosis.diagnose import Diagnosis
 from landing_gear_sim.diagnosis.relations import Z_VIOLATED, Check, Relation
 from landing_gear_sim.diagnosis.residuals import Spectrum
 from landing_gear_sim.diagnosis.scoring import BIC_THRESHOLD, HELD_OUT_THRESHOLD
 from landing_gear_sim.model.datasheet import UNITS, datasheet_values
 from landing_gear_sim.model.parameters import RigParameters
 from landing_gear_sim.processes import Call, map_forked
-from landing_gear_sim.report.figures import DISPLAY_UNITS, fixed_margins, save_figure
+from landing_gear_sim.report.figures import fixed_margins, save_figure
 from landing_gear_sim.report.first_screen import first_figure
 from landing_gear_sim.report.local_gain import local_gain_section
-from landing_gear_sim.report.pages import html_image, html_table, text_table, write_report
+from landing_gear_sim.report.pages import html_image, html_table, write_report
 from landing_gear_sim.report.words import (
     candidate_values,
     evidence_class,
     fits_words,
+    gain_text,
     headline,
     held_out_words,
     open_sentence,
     parameters_text,
     title_words,
-    verdict_text,
 )
 from msg_tools.run import Run
-from msg_tools.units import display
+from msg_tools.units import DISPLAY_UNITS, display
 
 
 def plot_before_after(measured: Run, before: Run, after: Run, channels: Sequence[str],
@@ -147,14 +147,14 @@ def diagnosis_sections(result: Diagnosis, folder: Path) -> list[tuple[str, str]]
           + (f" — in the {f.equation} ({channel_words(f.channel)})" if f.equation else ""),
           parameters_text(f), evidence_class(f.delta_bic),
           held_out_words(f).removeprefix("on the runs it was not fitted on ") or "-",
-          fits_words(f.fit_before), fits_words(f.fit_after), _text(_gain(f.held_out)),
+          fits_words(f.fit_before), fits_words(f.fit_after), gain_text(f.held_out),
           f.evidence] for f in result.findings])
     candidates = html_table(
         ["round", "cause", "accepted", "why", "key parameters", "evidence (ΔBIC)",
          "held-out log-likelihood gain", "fitted on", "checked on"],
         [[str(f.round or "discovery"), f.cause, "yes" if f.accepted else "no", f.reason,
           candidate_values(f, result.findings), evidence_class(f.delta_bic),
-          _text(_gain(f.held_out)), ", ".join(f.fitted_on), ", ".join(f.checked_on)]
+          gain_text(f.held_out), ", ".join(f.fitted_on), ", ".join(f.checked_on)]
          for f in result.candidates])
     figure = drawn[PAGE, "first screen"]
     left_open = open_sentence(result)
@@ -347,59 +347,3 @@ def _datasheet(params: RigParameters) -> str:
                       if isinstance(value, float) else f"{key} = {value}"
                       for key, value in given.items())
     return f" (from the datasheet, over the reference rig: {shown})"
-
-
-def _text(value: float | None) -> str:
-    """A ΔBIC or a held-out gain, as every table and the terminal write it, to the tenth
-    the JSON's reader checks (the terminal's +78 had been the page's +79)."""
-    return "-" if value is None else f"{value:+.1f}"
-
-
-def _gain(held_out: float | None) -> float | None:
-    """A held-out log-likelihood change as the improvement it is (positive: better)."""
-    return None if held_out is None else -held_out
-
-
-def diagnosis_summary(result: Diagnosis) -> str:
-    """The terminal summary: candidates, baseline fit, verdict, findings, notes."""
-    rows = [[str(f.round or "disc."), f.cause, "yes" if f.accepted else "no",
-             evidence_class(f.delta_bic), _text(_gain(f.held_out)),
-             f"{_fits(f.fit_before)} -> {_fits(f.fit_after)}", f.reason]
-            for f in result.candidates]
-    header = ["round", "cause", "accepted", "evidence (dBIC)", "held-out gain",
-              "held-out fit %", "why"]
-    lines = ["candidates:", text_table(header, rows) if rows
-             else "  (none: the model has them all)"]
-    lines.append(f"baseline fit %: {_fits(result.baseline)}")
-    lines.append(f"VERDICT: {verdict_text(result)}")
-    lines.append(f"  {headline(result)}")
-    if left_open := open_sentence(result):
-        lines.append(f"  {left_open}")
-    if result.verdict == INCONCLUSIVE:
-        lines.append("  the runs given cannot test every candidate, or none is left to check one "
-                     "on: see the notes")
-    # the headline holds each finding's values and law, the first's held-out gain: what
-    # follows is what it does not (the parameters had been printed twice, the evidence thrice)
-    for i, f in enumerate(result.findings):
-        lines.append(f"  {f.cause}" + (f" ({f.family})" if f.family else "") + ":")
-        if f.equation:
-            lines.append(f"    where: the {f.equation} (seen in the {channel_words(f.channel)})")
-        if i and f.fit_after and f.fit_after != f.fit_before:
-            gain = ", ".join(f"{channel_words(c)} {f.fit_before[c]:.2f} -> {f.fit_after[c]:.2f} %"
-                             for c in f.fit_after)
-            lines.append(f"    held-out gain: {gain}")
-        lines.append(f"    evidence: {f.evidence}")
-    before = [c for c in result.consistency_calibrated if c.violated]
-    broken = [c for c in result.consistency if c.violated]
-    noise = sum(c.within_input_noise for c in broken)
-    lines.append(f"consistency: {len(result.consistency)} relations checked, "
-                 f"{len(before)} violated under the calibrated model, {len(broken)} under the "
-                 "extended one" + (f" ({noise} within the noise in the model's inputs)"
-                                   if noise else "") + (":" if broken else ""))
-    lines.extend(f"  {c.describe()}" for c in broken)
-    lines.extend(f"  note: {problem}" for problem in result.problems)
-    return "\n".join(lines)
-
-
-def _fits(values: dict[str, float]) -> str:
-    return ", ".join(f"{c.split('_')[0]} {v:.1f}" for c, v in values.items())

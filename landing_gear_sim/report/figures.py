@@ -1,5 +1,6 @@
 """Figures of the model: a simulated run, the frequency responses; and what every figure
-shares (saving, display units). Functions take computed results; they never simulate.
+shares (the Agg backend, saving, margins). Functions take computed results; they never
+simulate.
 """
 
 from __future__ import annotations
@@ -7,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
+import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -14,11 +16,9 @@ from landing_gear_sim.model.integrate import SimulationResult
 from landing_gear_sim.model.linear import FrequencyResponse
 from msg_tools.units import PA_PER_BAR
 
-DISPLAY_UNITS: dict[str, tuple[float, str]] = {
-    "pressure_pa": (1 / PA_PER_BAR, "bar"), "wheel_speed_rad_s": (1.0, "rad/s"),
-    "flywheel_speed_rad_s": (1.0, "rad/s"), "vertical_load_n": (1e-3, "kN"),
-    "longitudinal_force_n": (1e-3, "kN")}
-"""Run channel (SI) → (factor, unit) it is shown in."""
+# every module that draws imports this one before it draws: figures go to PNG files on any
+# machine, a display or none (pyplot picks its backend at the first figure, not at import)
+matplotlib.use("Agg")
 
 
 def save_figure(fig: plt.Figure, path: Path) -> Path:

@@ -15,7 +15,8 @@ from landing_gear_sim.calibration.measured import channel_words
 from landing_gear_sim.diagnosis.diagnose import Diagnosis
 from landing_gear_sim.diagnosis.scoring import whole_run
 from landing_gear_sim.diagnosis.signatures import RunEvidence
-from landing_gear_sim.report.figures import DISPLAY_UNITS, save_figure
+from landing_gear_sim.report.figures import save_figure
+from msg_tools.units import DISPLAY_UNITS
 
 SMOOTHING_S = 0.2  # the residual's envelope: a noise spike is not where the model misses
 MIN_HALF_WINDOW_S = 0.5  # the window shown: at least this either side of the worst place ...

@@ -12,8 +12,7 @@ from landing_gear_sim.diagnosis.alike import Alike, name_of
 from landing_gear_sim.diagnosis.diagnose import INCONCLUSIVE, Diagnosis
 from landing_gear_sim.diagnosis.families import REGISTRY
 from landing_gear_sim.diagnosis.findings import Finding
-from landing_gear_sim.report.figures import DISPLAY_UNITS
-from msg_tools.units import display
+from msg_tools.units import DISPLAY_UNITS, display
 
 CAUSE_WORDS: dict[str, str] = {
     "actuator_delay": "the valve answers later than the model's",
@@ -50,6 +49,13 @@ def evidence_class(delta_bic: float | None) -> str:
         return "-"
     name = next((n for bound, n in EVIDENCE_CLASSES if delta_bic <= bound), "against")
     return f"{name} ({delta_bic:+.1f})"
+
+
+def gain_text(held_out: float | None) -> str:
+    """A held-out log-likelihood change as the improvement it is (positive: better), to
+    the tenth the JSON's reader checks, as every table and the terminal write it (the
+    terminal's +78 had been the page's +79); '-' where none was scored."""
+    return "-" if held_out is None else f"{-held_out:+.1f}"
 
 
 def fits_words(values: dict[str, float]) -> str:

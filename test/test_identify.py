@@ -108,7 +108,8 @@ def test_steps_without_their_runs_are_skipped_and_the_rest_runs(campaign_dir, re
                                                                  tmp_path):
     for run in campaign_dir.glob("brake_*.csv"):
         shutil.copy(run, tmp_path / run.name)
-    result = identify(read_campaign(tmp_path).runs, reference)
+    # the steps that run and those skipped, not their spread: no leave-one-run-out fits
+    result = identify(read_campaign(tmp_path).runs, reference, jackknife=False)
     assert any("valve static map: skipped" in p for p in result.problems)
     assert any("actuator dynamics A(s): skipped" in p for p in result.problems)
     assert {e.key for e in result.estimates} >= {"friction.theta1", "brake.gain_n_m_per_pa"}

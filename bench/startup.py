@@ -6,13 +6,16 @@ Run: ``python bench/startup.py [--against DIR]``. Each command runs in a fresh i
 ``git worktree``) run in the same session, and the table prints each command's time over
 that one's. The benchmark imports nothing of the project itself: what it measures is what
 a command imports and does. Targets (issue 61, a machine where ``--help`` takes 0.17 s):
-``params --write`` ≤ 0.5 s, ``metrics`` and ``convert`` of one 25 s run ≤ 1 s.
+``params --write`` ≤ 0.5 s, ``metrics`` and ``convert`` of one 25 s run ≤ 1 s. ``identify
+--partial`` of the same run, alone in a folder, has no target: a command that prints a table
+and draws nothing, whose imports show in its time (matplotlib: ~0.4 s, stop 71).
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -53,6 +56,9 @@ def _commands(folder: Path, tag: str) -> dict[str, Callable[[int], list[str]]]:
         "metrics": lambda i: ["metrics", run],
         "convert to csv": lambda i: ["convert", run, str(folder / f"copy{tag}{i}.csv")],
         "convert to bag": lambda i: ["convert", run, str(folder / f"bag{tag}{i}")],
+        # a command that prints a table and draws nothing (no target: what it imports)
+        "identify --partial": lambda i: ["identify", str(folder / "one"), "--partial", "-o",
+                                         str(folder / f"id{tag}{i}.yaml")],
     }
 
 
@@ -67,6 +73,8 @@ def main() -> None:
                         "--no-plot", "-o", str(folder / "run.csv")], env={
                             **os.environ, "PYTHONPATH": str(HERE)}, check=True,
                        stdout=subprocess.DEVNULL)
+        (folder / "one").mkdir()  # identify reads a folder: the run alone in it
+        shutil.copy(folder / "run.csv", folder / "one" / "run.csv")
         bare = _seconds(lambda i: [], None, args.repeat)
         print(f"python -c pass: {bare:.2f} s")
         print(f"{'command':18s} {'now s':>7s} {'target':>7s}" + (

@@ -309,10 +309,17 @@ def _outside(cause: str, rig: RigParameters, rng: np.random.Generator, seed: int
         generate_campaign(folder, rig, seed, logger=logger)
         runs = read_campaign(folder).runs
     result = diagnose(runs, datasheet)
-    first = result.findings[0] if result.findings else None
-    ok = (result.verdict == "discovered" and first is not None and first.family == equation
-          and first.held_out is not None and first.held_out < HELD_OUT_THRESHOLD)
-    return ok, _verdict(result), math.nan, result
+    return outside_right(result.to_json(), equation), _verdict(result), math.nan, result
+
+
+def outside_right(result: dict, equation: str) -> bool:
+    """Whether a diagnosis (its JSON, or the verdict guard's answer) of an OUTSIDE effect
+    is right: discovered in ``equation``, with a held-out gain."""
+    findings = result["findings"]
+    first = findings[0] if findings else {}
+    held_out = first.get("held_out_delta")
+    return (result["verdict"] == "discovered" and first.get("family") == equation
+            and held_out is not None and held_out < HELD_OUT_THRESHOLD)
 
 
 def _verdict(result: Diagnosis) -> str:

@@ -18,6 +18,12 @@ The campaigns (``--sets``, default all):
 - ``outside``: the own outside-the-library sweep (``bench/detection.py``'s OUTSIDE causes,
   its seeds, logged as its random loggers log).
 
+Where a campaign's truth is known (independent, unseen, outside), each answer is also judged
+by it, as ``detection.py`` judges it, and the run ends with how many are right, after and
+kept: two answers that differ may both be right, or the change may have cost a right one.
+A kept file written before the answers carried what a judgement needs (a finding's held-out
+gain, the final valve's ω_n and ζ) is judged only where it does not need them.
+
 Generated campaigns are written once under ``--campaigns`` (default
 ``out/verdicts/campaigns``) and read from there afterwards: the data stay those the kept
 answers were made on, whatever the change does to the generator. Each answer is written to
@@ -32,7 +38,8 @@ import math
 import sys
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 import detection
@@ -42,6 +49,7 @@ import numpy as np
 
 from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
 from landing_gear_sim.diagnosis.diagnose import diagnose
+from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import load_parameters
 from msg_tools.io import read_runs
 
@@ -65,13 +73,35 @@ class Campaign:
     without: tuple[str, ...] = ()
     datasheet: Path | None = None
     make: Callable[[Path], None] | None = None
+    right: Callable[[Answer], bool | None] | None = None  # by its truth; None: none known
 
 
 def _shared(kind: str) -> Iterator[Campaign]:
     folder = independent.FOLDER if kind == "independent" else independent.UNSEEN
     for path in independent.campaigns(folder):
         without = independent.expected(path).without if kind == "independent" else ()
-        yield Campaign(f"{kind}/{path.name}", path, without, independent.datasheet_of(path))
+        yield Campaign(f"{kind}/{path.name}", path, without, independent.datasheet_of(path),
+                       right=_truth(kind, path))
+
+
+def _truth(kind: str, path: Path) -> Callable[[Answer], bool | None]:
+    """How a shared campaign's answer is judged, as ``detection.py`` judges it: its cause
+    and key parameters (independent), its effect discovered in its equation (unseen), or
+    another rig's truth (an unseen campaign with a datasheet)."""
+    if kind == "independent":
+        want = independent.expected(path)
+        return lambda answer: independent.judge(answer, want).ok
+    equation = independent.unseen_equation(path)
+    if equation is not None:
+        return lambda answer: independent.judge_unseen(answer, equation)[0]
+
+    def datasheet_right(answer: Answer) -> bool | None:
+        valve = answer.get("valve")
+        if not isinstance(valve, dict):
+            return None
+        return independent.judge_datasheet(answer, valve["natural_frequency_hz"],
+                                           valve["damping_ratio"], path)[0]
+    return datasheet_right
 
 
 def _bench(root: Path) -> Iterator[Campaign]:
@@ -103,7 +133,15 @@ def _outside(root: Path, seed: int = 1000, per_cause: int = 3) -> Iterator[Campa
             def make(folder: Path, cause: str = cause, number: int = number) -> None:
                 _write_outside(folder, cause, number)
             yield Campaign(f"outside/{cause}-{number}", root / "outside" / f"{cause}-{number}",
-                           make=make)
+                           make=make, right=partial(_outside_right, cause=cause))
+
+
+def _outside_right(answer: Answer, cause: str) -> bool | None:
+    findings = answer["findings"]
+    assert isinstance(findings, list)
+    if findings and "held_out_delta" not in findings[0]:
+        return None  # kept before the answers carried it
+    return detection.outside_right(answer, detection.OUTSIDE[cause][0])
 
 
 def _write_outside(folder: Path, cause: str, seed: int) -> None:
@@ -136,7 +174,12 @@ def answer(campaign: Campaign) -> Answer:
     return {"verdict": result.verdict,
             "findings": [{"cause": f.cause, "family": f.family, "equation": f.equation,
                           "term": f.term, "parameters": dict(f.parameters),
-                          "uncertainty": dict(f.std)} for f in result.findings],
+                          "uncertainty": dict(f.std), "held_out_delta": f.held_out}
+                         for f in result.findings],
+            # what the truth's judges read beside the findings, not compared
+            "valve": {"natural_frequency_hz": result.extended.number(
+                          K.ACTUATOR_NATURAL_FREQUENCY_HZ),
+                      "damping_ratio": result.extended.number(K.ACTUATOR_DAMPING_RATIO)},
             # what the campaign leaves open: said beside the verdict, not compared
             "alike": [list(group.names) for group in result.alike],
             "next_run": None if result.next_run is None else result.next_run.proposal.options}
@@ -191,6 +234,7 @@ def main() -> int:
     output = args.save or args.output or args.against.with_suffix(".after.json")
     done = json.loads(output.read_text(encoding="utf-8")) if output.is_file() else {}
     found = 0
+    right = Right()
     for campaign in plan(args.sets.split(","), args.campaigns):
         if args.only not in campaign.key:
             continue
@@ -208,14 +252,47 @@ def main() -> int:
                          for f in now["findings"])
         line = f"{campaign.key:50s} {now['verdict']:12s} {shown}" + "".join(
             f" [{' or '.join(group)}]" for group in now.get("alike", []))
+        right.add(campaign, now, kept.get(campaign.key))
         if args.against:
             diff = differences(kept[campaign.key], now)
             found += bool(diff)
             line += "  SAME" if not diff else "  DIFFERS: " + "; ".join(diff)
         print(line, flush=True)
+    print(right.summary(bool(args.against)))
     if args.against:
         print(f"{found} campaigns differ; answers in {output}")
     return 1 if found else 0
+
+
+@dataclass
+class Right:
+    """How many answers are right by their campaign's truth, now and kept, and which
+    changed: counted where both are judged, so the two counts compare."""
+
+    judged: int = 0
+    now: int = 0
+    kept: int = 0
+    changed: list[str] = field(default_factory=list)
+
+    def add(self, campaign: Campaign, now: Answer, kept: Answer | None) -> None:
+        if campaign.right is None:
+            return
+        was = campaign.right(kept) if kept is not None else None
+        is_right = campaign.right(now)
+        if is_right is None or (kept is not None and was is None):
+            return
+        self.judged += 1
+        self.now += is_right
+        self.kept += bool(was)
+        if kept is not None and was != is_right:
+            self.changed.append(f"{campaign.key} ({'now right' if is_right else 'now wrong'})")
+
+    def summary(self, against: bool) -> str:
+        line = f"right by the truth: {self.now}/{self.judged}"
+        if against:
+            line += (f" (kept: {self.kept}/{self.judged})"
+                     + "".join(f"; {key}" for key in self.changed))
+        return line
 
 
 if __name__ == "__main__":

@@ -47,3 +47,44 @@ def test_the_identification_bench_refuses_code_before_that_is_no_checkout(tmp_pa
                            str(tmp_path)], capture_output=True, text=True, timeout=120)
     assert done.returncode == 2, done.stderr
     assert f"{tmp_path} is not a checkout of the package" in done.stderr
+
+
+def _answer(verdict: str, family: str = "", **finding: object) -> dict:
+    findings = [{"cause": verdict, "family": family, "equation": "", "term": "",
+                 "parameters": {}, "uncertainty": {}, **finding}] if family else []
+    return {"verdict": verdict, "findings": findings}
+
+
+def test_the_verdict_guard_counts_the_answers_right_by_their_campaigns_truth(
+        tmp_path, monkeypatch):
+    """Two answers that differ may both be right, or the change may have cost a right one:
+    the guard judges each by its campaign's truth as detection.py does (an outside effect:
+    discovered in its equation with a held-out gain; another rig's null: none) and says
+    which changed; a kept answer without what its judge reads is not counted."""
+    monkeypatch.syspath_prepend(str(ROOT / "bench"))
+    import detection
+    import verdicts
+
+    outside = next(c for c in verdicts.plan(["outside"], tmp_path)
+                   if c.key.startswith("outside/wheel_drag_rising"))
+    equation = detection.OUTSIDE["wheel_drag_rising"][0]
+    assert outside.right is not None
+    found = _answer("discovered", equation, held_out_delta=-40.0)
+    assert outside.right(found)
+    assert not outside.right(_answer("discovered", equation, held_out_delta=3.0))
+    assert not outside.right(_answer("discovered", "tyre", held_out_delta=-40.0))
+    assert outside.right(_answer("discovered", equation)) is None  # kept before held-out
+    other_rig = tmp_path / "U99_null"
+    other_rig.mkdir()
+    (other_rig / "truth.json").write_text('{"effect": {"equation": "none"}}')
+    null = verdicts.Campaign("unseen/U99_null", other_rig,
+                             right=verdicts._truth("unseen", other_rig))
+    valve = {"natural_frequency_hz": 14.0, "damping_ratio": 0.5}
+    right = verdicts.Right()
+    right.add(outside, found, _answer("unexplained"))
+    right.add(null, {**_answer("discovered", "wheel"), "valve": valve},
+              {**_answer("none"), "valve": valve})
+    right.add(null, {**_answer("none"), "valve": valve}, _answer("none"))  # kept: no valve
+    assert right.summary(against=True) == (
+        f"right by the truth: 1/2 (kept: 1/2); {outside.key} (now right); "
+        "unseen/U99_null (now wrong)")

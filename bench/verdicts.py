@@ -79,17 +79,16 @@ class Campaign:
 def _shared(kind: str) -> Iterator[Campaign]:
     folder = independent.FOLDER if kind == "independent" else independent.UNSEEN
     for path in independent.campaigns(folder):
-        without = independent.expected(path).without if kind == "independent" else ()
-        yield Campaign(f"{kind}/{path.name}", path, without, independent.datasheet_of(path),
-                       right=_truth(kind, path))
+        want = independent.expected(path) if kind == "independent" else None
+        yield Campaign(f"{kind}/{path.name}", path, want.without if want else (),
+                       independent.datasheet_of(path), right=_truth(path, want))
 
 
-def _truth(kind: str, path: Path) -> Callable[[Answer], bool | None]:
+def _truth(path: Path, want: independent.Expected | None) -> Callable[[Answer], bool | None]:
     """How a shared campaign's answer is judged, as ``detection.py`` judges it: its cause
-    and key parameters (independent), its effect discovered in its equation (unseen), or
-    another rig's truth (an unseen campaign with a datasheet)."""
-    if kind == "independent":
-        want = independent.expected(path)
+    and key parameters (an independent campaign's ``want``), its effect discovered in its
+    equation (unseen), or another rig's truth (an unseen campaign with a datasheet)."""
+    if want is not None:
         return lambda answer: independent.judge(answer, want).ok
     equation = independent.unseen_equation(path)
     if equation is not None:

@@ -78,7 +78,7 @@ def test_the_verdict_guard_counts_the_answers_right_by_their_campaigns_truth(
     other_rig.mkdir()
     (other_rig / "truth.json").write_text('{"effect": {"equation": "none"}}')
     null = verdicts.Campaign("unseen/U99_null", other_rig,
-                             right=verdicts._truth("unseen", other_rig))
+                             right=verdicts._truth(other_rig, None))
     valve = {"natural_frequency_hz": 14.0, "damping_ratio": 0.5}
     right = verdicts.Right()
     right.add(outside, found, _answer("unexplained"))

@@ -22,6 +22,7 @@ from .contract import (
     TOPIC_WRENCH,
     VALVE_JOINT,
 )
+from .contract_cdr import contract_rows
 from .errors import RunFormatError
 from .run import Run
 from .stamps import ns_of_time, stamp_fields
@@ -88,12 +89,13 @@ def write_bag(run: Run, path: Path, storage: str = "mcap") -> None:
     # folder of the final name, inside the hidden stage
     with Writer(stage / path.name, version=BAG_VERSION,
                 storage_plugin=STORAGE[storage]) as writer:
-        connections = {topic: writer.add_connection(topic, msgtype, typestore=TYPESTORE)
-                       for topic, msgtype in TOPIC_TYPES.items()}
-        for k in range(len(run)):
-            log_time = ns_of_time(float(run.time_s[k]))
-            for topic, message in contract_messages(run, k).items():
-                data = TYPESTORE.serialize_cdr(message, TOPIC_TYPES[topic])
-                writer.write(connections[topic], log_time, data)
+        connections = [writer.add_connection(topic, msgtype, typestore=TYPESTORE)
+                       for topic, msgtype in TOPIC_TYPES.items()]
+        log_ns, rows = contract_rows(run)
+        topics = [(connection, rows[topic].tobytes(), rows[topic].itemsize)
+                  for connection, topic in zip(connections, TOPIC_TYPES, strict=True)]
+        for k, log_time in enumerate(log_ns.tolist()):
+            for connection, data, size in topics:
+                writer.write(connection, log_time, data[k * size:(k + 1) * size])
     os.replace(stage / path.name, path)
     stage.rmdir()

@@ -6,12 +6,19 @@ graph) and every reader reads back; the message types (rosbags' or rclpy's) stay
 
 from __future__ import annotations
 
+import numpy as np
+
 NS_PER_S = 1_000_000_000
 
 
 def ns_of_time(time_s: float) -> int:
     """A time [s] to the nearest nanosecond."""
     return round(time_s * 1e9)
+
+
+def ns_of_times(time_s: np.ndarray) -> np.ndarray:
+    """:func:`ns_of_time` of each time, as int64 (the same rounding: half to even)."""
+    return np.rint(np.asarray(time_s, dtype=float) * 1e9).astype(np.int64)
 
 
 def stamp_fields(nanoseconds: int) -> dict[str, int]:

@@ -51,6 +51,32 @@ def test_bag_round_trip_keeps_every_topic(tmp_path, run, storage):
     assert np.allclose(back.pressure_pa, run.pressure_pa, rtol=0, atol=1e-8)
 
 
+def test_a_runs_messages_serialised_at_once_are_rosbags_own_to_the_bit(run):
+    """The fixed layouts of a bag's fast path against rosbags' ``serialize_cdr`` of the
+    messages ``contract_messages`` builds, every topic and every sample: times with odd
+    nanoseconds and before the epoch, forces of both signs, loads, a current of 0."""
+    from msg_tools.bag_io import contract_messages
+    from msg_tools.contract import TOPIC_TYPES
+    from msg_tools.contract_cdr import contract_rows
+    from msg_tools.stamps import ns_of_time
+
+    rng = np.random.default_rng(5)
+    n = 300
+    odd = dataclasses.replace(
+        run.part(slice(0, n), "odd"), time_s=np.sort(rng.uniform(-3.0, 2e3, n)),
+        current_a=np.where(rng.random(n) < 0.2, 0.0, rng.normal(0.5, 0.3, n)),
+        pressure_pa=rng.uniform(-1e4, 2e7, n), wheel_speed_rad_s=rng.normal(0, 100, n),
+        flywheel_speed_rad_s=rng.normal(0, 50, n), vertical_load_n=rng.normal(2e4, 1e4, n),
+        longitudinal_force_n=rng.normal(0, 5e3, n))
+    for case in (run, odd):
+        log_ns, rows = contract_rows(case)
+        assert log_ns.tolist() == [ns_of_time(float(t)) for t in case.time_s]
+        for k in range(len(case)):
+            for topic, message in contract_messages(case, k).items():
+                expected = bytes(TYPESTORE.serialize_cdr(message, TOPIC_TYPES[topic]))
+                assert rows[topic][k].tobytes() == expected, (topic, k)
+
+
 def test_existing_bag_is_not_overwritten(tmp_path, run):
     (tmp_path / "bag").mkdir()
     with pytest.raises(RunFormatError, match="exists already"):

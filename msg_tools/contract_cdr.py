@@ -1,0 +1,125 @@
+"""A run's contract messages serialised all at once, as rows of fixed CDR layouts.
+
+Every message of a contract topic has one layout: its frame id and joint name are the
+same in every sample, so only its stamp and its numbers change, at fixed offsets. A run's
+messages of one topic are then the rows of one numpy structured array, filled column by
+column. rosbags builds and serialises them one message object at a time, ~10 µs each:
+~1 s for the ~100,000 messages of a 20 s run, most of a ``convert`` to a bag (issue 61's
+target is 1 s for the whole command). The bytes are rosbags' own, to the bit (the layouts
+are checked against its ``serialize_cdr``: ``test_msg_tools``); a message that needs
+another layout goes through :func:`msg_tools.bag_io.contract_messages` and rosbags.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .contract import (
+    ATMOSPHERE_PA,
+    TOPIC_CURRENT,
+    TOPIC_FLYWHEEL,
+    TOPIC_PRESSURE,
+    TOPIC_WHEEL,
+    TOPIC_WRENCH,
+    VALVE_JOINT,
+)
+from .run import Run
+from .stamps import NS_PER_S, ns_of_times
+
+HEADER = b"\x00\x01\x00\x00"
+"""CDR's encapsulation header: plain CDR, little-endian (as rosbags and rclpy write)."""
+
+Item = tuple[str, str, object]
+"""A layout's item: (name, numpy format, constant value or None for a column)."""
+
+
+def _string(name: str, text: str) -> list[Item]:
+    data = text.encode() + b"\x00"
+    return [(f"{name}.length", "<u4", len(data)), (name, f"S{len(data)}", data)]
+
+
+def _doubles(name: str, count: int) -> list[Item]:
+    """A sequence of ``count`` float64 (its count, then its elements as columns)."""
+    return [(f"{name}.count", "<u4", count),
+            *[(f"{name}[{i}]", "<f8", None) for i in range(count)]]
+
+
+def _header(frame: str) -> list[Item]:
+    return [("sec", "<i4", None), ("nanosec", "<u4", None), *_string("frame_id", frame)]
+
+
+def _joint(name: str, velocity: int, effort: int) -> list[Item]:
+    return [*_header(name), ("name.count", "<u4", 1), *_string("name[0]", name),
+            *_doubles("position", 0), *_doubles("velocity", velocity),
+            *_doubles("effort", effort)]
+
+
+@dataclass(frozen=True)
+class Layout:
+    """One message type's fixed CDR layout: a structured dtype whose fields sit where CDR
+    aligns them (each primitive on a multiple of its size, counted from the end of the
+    encapsulation header), and the fields every message holds the same value in."""
+
+    dtype: np.dtype
+    constants: dict[str, object]
+
+    @classmethod
+    def of(cls, items: Sequence[Item]) -> Layout:
+        names, formats, offsets = ["header"], ["S4"], [0]
+        constants: dict[str, object] = {"header": HEADER}
+        end = len(HEADER)
+        for name, fmt, value in items:
+            size = np.dtype(fmt).itemsize
+            align = 1 if fmt.startswith("S") else size
+            end = len(HEADER) + -(-(end - len(HEADER)) // align) * align
+            names.append(name)
+            formats.append(fmt)
+            offsets.append(end)
+            if value is not None:
+                constants[name] = value
+            end += size
+        dtype = np.dtype({"names": names, "formats": formats, "offsets": offsets,
+                          "itemsize": end})
+        return cls(dtype, constants)
+
+    def rows(self, columns: dict[str, np.ndarray]) -> np.ndarray:
+        """The messages whose varying fields are ``columns`` (each of the run's length);
+        padding bytes are zero, as rosbags writes them."""
+        n = len(next(iter(columns.values())))
+        out = np.zeros(n, self.dtype)
+        for name, value in (self.constants | columns).items():
+            out[name] = value
+        return out
+
+
+LAYOUTS: dict[str, Layout] = {
+    TOPIC_CURRENT: Layout.of(_joint(VALVE_JOINT, velocity=0, effort=1)),
+    TOPIC_PRESSURE: Layout.of([*_header("brake"), ("fluid_pressure", "<f8", None),
+                               ("variance", "<f8", 0.0)]),
+    TOPIC_WHEEL: Layout.of(_joint("wheel", velocity=1, effort=0)),
+    TOPIC_FLYWHEEL: Layout.of(_joint("flywheel", velocity=1, effort=0)),
+    TOPIC_WRENCH: Layout.of([*_header("load_cell"), *[
+        (f"{part}.{axis}", "<f8", None if (part, axis) in (("force", "x"), ("force", "z"))
+         else 0.0) for part in ("force", "torque") for axis in "xyz"]]),
+}
+"""The contract topics' layouts, as :func:`msg_tools.bag_io.contract_messages` builds them."""
+
+
+def contract_rows(run: Run) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """``run``'s log times [ns] and each contract topic's serialised messages, a row a
+    sample (``rows[topic][k].tobytes()`` is sample k's message)."""
+    log_ns = ns_of_times(run.time_s)
+    sec, nanosec = np.divmod(log_ns, NS_PER_S)
+    stamp = {"sec": sec, "nanosec": nanosec}
+    values = {
+        TOPIC_CURRENT: {"effort[0]": run.current_a},
+        TOPIC_PRESSURE: {"fluid_pressure": run.pressure_pa + ATMOSPHERE_PA},
+        TOPIC_WHEEL: {"velocity[0]": run.wheel_speed_rad_s},
+        TOPIC_FLYWHEEL: {"velocity[0]": run.flywheel_speed_rad_s},
+        TOPIC_WRENCH: {"force.x": run.longitudinal_force_n, "force.z": run.vertical_load_n},
+    }
+    return log_ns, {topic: LAYOUTS[topic].rows(stamp | columns)
+                    for topic, columns in values.items()}

@@ -62,6 +62,11 @@ class FieldPath:
                                  "velocity[0]")
         return steps
 
+    @cached_property
+    def absolute(self) -> bool:
+        """Whether it reads a FluidPressure: absolute, where the contract is gauge."""
+        return self.steps[-1][0] == "fluid_pressure"
+
     def read(self, message: Any) -> tuple[float, bool]:
         """(value, whether it is a JointState position standing in for a velocity)."""
         value: Any = message
@@ -74,8 +79,8 @@ class FieldPath:
                 value = value[_index(message, index)]
         if name == "position":
             position = True
-        if name == "fluid_pressure":
-            value = value - ATMOSPHERE_PA  # FluidPressure is absolute; the contract is gauge
+        if self.absolute:
+            value = value - ATMOSPHERE_PA
         return float(value), position
 
 

@@ -2,7 +2,10 @@
 
 Messages are streamed: each is reduced to its stamp and the numbers the run needs as it is
 read (``array('d')``), so memory grows with the samples kept, not with the messages
-decoded. Stamped topics are matched to the wheel encoder's stamps by linear interpolation,
+decoded. A contract topic's messages that hold its fixed layout (:mod:`msg_tools.contract_cdr`:
+the contract's frames and joints, as this package and the graph write them) are read
+by that layout, a few thousand at once: through rosbags one by one, a 20 s run's ~100,000
+messages took ~0.8 s of its 1.15 s read. Stamped topics are matched to the wheel encoder's stamps by linear interpolation,
 the current command by its stamp (the end of the interval it holds for), or a 0.1
 bag's ``Float64`` current by log time, held as the valve sees it.
 """
@@ -18,12 +21,13 @@ from typing import Any
 import numpy as np
 from rosbags.highlevel import AnyReader
 
-from .bag_fields import Source, resolve
+from .bag_fields import CONTRACT_SOURCES, Source, resolve
 from .bag_files import storage_files
 from .bag_io import TYPESTORE
 from .bag_recover import recovered
 from .checks import check_plausible
-from .contract import CSV_TO_FIELD, MAY_LACK
+from .contract import ATMOSPHERE_PA, CSV_TO_FIELD, MAY_LACK, TOPIC_TYPES
+from .contract_cdr import COLUMNS, LAYOUTS, Layout
 from .derivative import speed_from_angle
 from .errors import RunFormatError
 from .mapping import DEFAULT_MAPPING, Mapping
@@ -128,33 +132,125 @@ def _lost(reader: AnyReader, read: Counter[str]) -> list[str]:
             f"in it ({total - n} lost)" for (n, total), topics in short.items()]
 
 
+CHUNK = 4096
+"""Messages of a topic read by its layout at once: the raw bytes held stay small."""
+
+
+@dataclass
+class _ByLayout:
+    """A contract topic whose messages are read by their fixed layout
+    (:mod:`msg_tools.contract_cdr`), a chunk at a time, as long as they hold its constants."""
+
+    layout: Layout
+    msgtype: str
+    columns: list[tuple[Source, str]]
+    pending: list[tuple[int, bytes]] = field(default_factory=list)
+
+
+def _by_layout(sources: list[Source], types: dict[str, str]) -> dict[str, _ByLayout]:
+    """The bag's topics whose every source reads a contract field of its contract type."""
+    plans: dict[str, _ByLayout] = {}
+    refused = set()
+    for source in sources:
+        contract_topic = CONTRACT_SOURCES[source.contract][0]
+        column = COLUMNS.get((contract_topic, source.field.text))
+        if column is None or types[source.topic] != TOPIC_TYPES[contract_topic]:
+            refused.add(source.topic)
+            continue
+        layout = LAYOUTS[contract_topic]
+        plan = plans.setdefault(source.topic, _ByLayout(layout, types[source.topic], []))
+        if plan.layout is not layout:
+            refused.add(source.topic)
+        plan.columns.append((source, column))
+    return {topic: plan for topic, plan in plans.items() if topic not in refused}
+
+
 def _stream(reader: AnyReader, sources: list[Source]) -> tuple[dict[str, _Series],
                                                                 Counter[str]]:
     """The contract columns of ``sources`` as they stream in, and the messages read per
     topic."""
-    by_topic: dict[str, list[Source]] = {}
-    for source in sources:
-        by_topic.setdefault(source.topic, []).append(source)
-    stamps = {topic: array("d") for topic in by_topic}
-    series = {s.contract: _Series(stamps[s.topic]) for s in sources}
-    wanted = [c for c in reader.connections if c.topic in by_topic]
-    read: Counter[str] = Counter()
-    for connection, log_time, raw in reader.messages(connections=wanted):
-        read[connection.topic] += 1
-        message = reader.deserialize(raw, connection.msgtype)
+    streams = _Streams(reader, sources)
+    for connection, log_time, raw in reader.messages(connections=streams.wanted):
+        streams.take(connection.topic, connection.msgtype, log_time, raw)
+    streams.finish()
+    return streams.series, streams.read
+
+
+class _Streams:
+    """Each source's column as the messages come: a contract topic's by its layout, a
+    chunk at a time (the messages that leave it, and every other topic's, through
+    rosbags one by one, in order)."""
+
+    def __init__(self, reader: AnyReader, sources: list[Source]) -> None:
+        self._reader = reader
+        self._by_topic: dict[str, list[Source]] = {}
+        for source in sources:
+            self._by_topic.setdefault(source.topic, []).append(source)
+        self._stamps = {topic: array("d") for topic in self._by_topic}
+        self.series = {s.contract: _Series(self._stamps[s.topic]) for s in sources}
+        self.wanted = [c for c in reader.connections if c.topic in self._by_topic]
+        self._plans = _by_layout(sources, {c.topic: c.msgtype for c in self.wanted})
+        self.read: Counter[str] = Counter()
+
+    def take(self, topic: str, msgtype: str, log_time: int, raw: bytes) -> None:
+        self.read[topic] += 1
+        plan = self._plans.get(topic)
+        if plan is not None and len(raw) == plan.layout.dtype.itemsize:
+            plan.pending.append((log_time, bytes(raw)))
+            if len(plan.pending) >= CHUNK:
+                self._flush(topic, plan)
+            return
+        if plan is not None:
+            self._flush(topic, plan)  # the messages before this one, first
+        self._one(topic, msgtype, log_time, raw)
+
+    def finish(self) -> None:
+        for topic, plan in self._plans.items():
+            self._flush(topic, plan)
+
+    def _flush(self, topic: str, plan: _ByLayout) -> None:
+        if not plan.pending:
+            return
+        rows = plan.layout.read(b"".join(raw for _, raw in plan.pending))
+        if rows is None:
+            for log_time, raw in plan.pending:
+                self._one(topic, plan.msgtype, log_time, raw)
+        else:
+            _append_rows(rows, np.array([t for t, _ in plan.pending]), self._stamps[topic],
+                         plan.columns, self.series)
+        plan.pending.clear()
+
+    def _one(self, topic: str, msgtype: str, log_time: int, raw: bytes) -> None:
+        message = self._reader.deserialize(raw, msgtype)
         stamp, stamped = _stamp_s(message, log_time)
-        stamps[connection.topic].append(stamp)
-        for source in by_topic[connection.topic]:
+        self._stamps[topic].append(stamp)
+        for source in self._by_topic[topic]:
             try:
                 value, position = source.field.read(message)
             except (AttributeError, IndexError, TypeError) as exc:
-                raise RunFormatError(f"{connection.topic} has no field {source.field.text} "
+                raise RunFormatError(f"{topic} has no field {source.field.text} "
                                      f"({type(exc).__name__}: {exc})") from None
-            target = series[source.contract]
+            target = self.series[source.contract]
             target.values.append(value)
             target.positions |= position
             target.stamped |= stamped
-    return series, read
+
+
+def _append_rows(rows: np.ndarray, log_ns: np.ndarray, stamps: array,
+                 columns: list[tuple[Source, str]], series: dict[str, _Series]) -> None:
+    """Rows of a contract layout appended as :func:`_stamp_s` and ``FieldPath.read`` read
+    each message: a header's stamp where it is set, else the log time."""
+    stamped = (rows["sec"] != 0) | (rows["nanosec"] != 0)
+    times = np.where(stamped, rows["sec"].astype(float) + rows["nanosec"] * 1e-9,
+                     log_ns * 1e-9)
+    stamps.frombytes(times.tobytes())
+    for source, column in columns:
+        values = rows[column].astype(float)
+        if source.field.absolute:
+            values = values - ATMOSPHERE_PA
+        target = series[source.contract]
+        target.values.frombytes(values.tobytes())
+        target.stamped |= bool(stamped.any())
 
 
 def _stamp_s(message: Any, log_time_ns: int) -> tuple[float, bool]:

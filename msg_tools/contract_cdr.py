@@ -65,6 +65,10 @@ class Layout:
 
     dtype: np.dtype
     constants: dict[str, object]
+    template: np.ndarray
+    """A message's bytes (uint8) with its constants and zero elsewhere."""
+    fixed: np.ndarray
+    """Which of its bytes hold a constant (bool)."""
 
     @classmethod
     def of(cls, items: Sequence[Item]) -> Layout:
@@ -83,7 +87,13 @@ class Layout:
             end += size
         dtype = np.dtype({"names": names, "formats": formats, "offsets": offsets,
                           "itemsize": end})
-        return cls(dtype, constants)
+        template = np.zeros(1, dtype)
+        fixed = np.zeros(end, bool)
+        for name, value in constants.items():
+            template[name] = value
+            offset = offsets[names.index(name)]
+            fixed[offset:offset + dtype[name].itemsize] = True
+        return cls(dtype, constants, template.view(np.uint8), fixed)
 
     def rows(self, columns: dict[str, np.ndarray]) -> np.ndarray:
         """The messages whose varying fields are ``columns`` (each of the run's length);
@@ -93,6 +103,18 @@ class Layout:
         for name, value in (self.constants | columns).items():
             out[name] = value
         return out
+
+
+    def read(self, messages: bytes) -> np.ndarray | None:
+        """The rows of ``messages`` (serialised messages of this layout, end to end), or
+        None unless every one holds the layout's constants (another frame or joint, a
+        longer name: they need rosbags)."""
+        rows = np.frombuffer(messages, self.dtype)
+        raw = np.frombuffer(messages, np.uint8).reshape(len(rows), self.dtype.itemsize)
+        if not np.array_equal(raw[:, self.fixed], np.broadcast_to(
+                self.template[self.fixed], (len(rows), int(self.fixed.sum())))):
+            return None
+        return rows
 
 
 LAYOUTS: dict[str, Layout] = {
@@ -106,6 +128,17 @@ LAYOUTS: dict[str, Layout] = {
          else 0.0) for part in ("force", "torque") for axis in "xyz"]]),
 }
 """The contract topics' layouts, as :func:`msg_tools.bag_io.contract_messages` builds them."""
+
+
+COLUMNS: dict[tuple[str, str], str] = {
+    (TOPIC_CURRENT, f"effort[{VALVE_JOINT}]"): "effort[0]",
+    (TOPIC_PRESSURE, "fluid_pressure"): "fluid_pressure",
+    (TOPIC_WHEEL, "velocity[wheel]"): "velocity[0]",
+    (TOPIC_FLYWHEEL, "velocity[flywheel]"): "velocity[0]",
+    (TOPIC_WRENCH, "wrench.force.z"): "force.z",
+    (TOPIC_WRENCH, "wrench.force.x"): "force.x",
+}
+"""(contract topic, the field a bag's reader reads there) → its layout's column."""
 
 
 def contract_rows(run: Run) -> tuple[np.ndarray, dict[str, np.ndarray]]:

@@ -77,6 +77,52 @@ def test_a_runs_messages_serialised_at_once_are_rosbags_own_to_the_bit(run):
                 assert rows[topic][k].tobytes() == expected, (topic, k)
 
 
+def test_a_bag_whose_messages_leave_the_contract_layout_midway_reads_as_message_by_message(
+        tmp_path, run, monkeypatch):
+    """The reader takes a topic's messages by their layout while they hold its constants:
+    where a frame is renamed (same length, then longer), a stamp is left 0 (the log time
+    stands in) or a joint logs its angle in place of its speed, those messages go through
+    rosbags, in order, and the run is the one reading every message through rosbags gives,
+    to the bit. A message of the layout's length with other constants is not the layout's."""
+    from msg_tools import bag_read
+    from msg_tools.bag_io import contract_messages
+    from msg_tools.contract import TOPIC_FLYWHEEL, TOPIC_PRESSURE, TOPIC_TYPES, TOPIC_WHEEL
+    from msg_tools.contract_cdr import LAYOUTS
+
+    def altered(k: int) -> dict:
+        messages = contract_messages(run, k)
+        if 100 <= k < 130:
+            messages[TOPIC_WHEEL].header.frame_id = "wheeL"  # same length, other bytes
+        if 200 <= k < 210:
+            messages[TOPIC_WHEEL].header.frame_id = "wheel_left"
+        if k % 7 == 0:
+            messages[TOPIC_PRESSURE].header.stamp.sec = 0
+            messages[TOPIC_PRESSURE].header.stamp.nanosec = 0
+        if k >= len(run) - 50:  # its angle logged in place of its speed
+            joint = messages[TOPIC_FLYWHEEL]
+            joint.position, joint.velocity = joint.velocity, joint.position
+        return messages
+
+    with Writer(tmp_path / "bag", version=BAG_VERSION) as writer:
+        connections = {topic: writer.add_connection(topic, kind, typestore=TYPESTORE)
+                       for topic, kind in TOPIC_TYPES.items()}
+        for k in range(len(run)):
+            for topic, message in altered(k).items():
+                writer.write(connections[topic], round(float(run.time_s[k]) * 1e9) + 3,
+                             TYPESTORE.serialize_cdr(message, TOPIC_TYPES[topic]))
+    monkeypatch.setattr(bag_read, "CHUNK", 64)
+    by_layout = read_bag(tmp_path / "bag")
+    monkeypatch.setattr(bag_read, "_by_layout", lambda sources, types: {})
+    by_message = read_bag(tmp_path / "bag")
+    for name in ("time_s", *SIGNALS):
+        assert np.array_equal(getattr(by_layout, name), getattr(by_message, name)), name
+    assert by_layout.notes == by_message.notes
+    renamed = bytes(TYPESTORE.serialize_cdr(altered(100)[TOPIC_WHEEL], TOPIC_TYPES[TOPIC_WHEEL]))
+    assert len(renamed) == LAYOUTS[TOPIC_WHEEL].dtype.itemsize
+    assert LAYOUTS[TOPIC_WHEEL].read(renamed) is None
+    assert LAYOUTS[TOPIC_WHEEL].read(renamed.replace(b"wheeL", b"wheel")) is not None
+
+
 def test_existing_bag_is_not_overwritten(tmp_path, run):
     (tmp_path / "bag").mkdir()
     with pytest.raises(RunFormatError, match="exists already"):

@@ -2,12 +2,13 @@
 
 Messages are streamed: each is reduced to its stamp and the numbers the run needs as it is
 read (``array('d')``), so memory grows with the samples kept, not with the messages
-decoded. A contract topic's messages that hold its fixed layout (:mod:`msg_tools.contract_cdr`:
-the contract's frames and joints, as this package and the graph write them) are read
-by that layout, a few thousand at once: through rosbags one by one, a 20 s run's ~100,000
-messages took ~0.8 s of its 1.15 s read. Stamped topics are matched to the wheel encoder's stamps by linear interpolation,
-the current command by its stamp (the end of the interval it holds for), or a 0.1
-bag's ``Float64`` current by log time, held as the valve sees it.
+decoded. A contract topic's messages that hold its fixed layout
+(:mod:`msg_tools.contract_cdr`: the contract's frames and joints, as this package and the
+graph write them) are read by that layout, a few thousand at once: through rosbags one by
+one, a 20 s run's ~100,000 messages took ~0.8 s of its 1.15 s read. Stamped topics are
+matched to the wheel encoder's stamps by linear interpolation, the current command by its
+stamp (the end of the interval it holds for), or a 0.1 bag's ``Float64`` current by log
+time, held as the valve sees it.
 """
 
 from __future__ import annotations

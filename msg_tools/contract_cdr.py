@@ -3,11 +3,13 @@
 Every message of a contract topic has one layout: its frame id and joint name are the
 same in every sample, so only its stamp and its numbers change, at fixed offsets. A run's
 messages of one topic are then the rows of one numpy structured array, filled column by
-column. rosbags builds and serialises them one message object at a time, ~10 µs each:
-~1 s for the ~100,000 messages of a 20 s run, most of a ``convert`` to a bag (issue 61's
-target is 1 s for the whole command). The bytes are rosbags' own, to the bit (the layouts
-are checked against its ``serialize_cdr``: ``test_msg_tools``); a message that needs
-another layout goes through :func:`msg_tools.bag_io.contract_messages` and rosbags.
+column, and a bag's messages that hold a layout's constants are read back the same way.
+rosbags builds and serialises them one message object at a time, ~10 µs each: ~1 s for
+the ~100,000 messages of a 20 s run, most of a ``convert`` to a bag (issue 61's target is
+1 s for the whole command), and ~0.8 s to read them. The bytes are rosbags' own, to the
+bit (the layouts are checked against its ``serialize_cdr``: ``test_msg_tools``); a
+message of another layout (another frame or joint, a position for a velocity) is read
+through rosbags (:mod:`msg_tools.bag_read`).
 """
 
 from __future__ import annotations
@@ -103,7 +105,6 @@ class Layout:
         for name, value in (self.constants | columns).items():
             out[name] = value
         return out
-
 
     def read(self, messages: bytes) -> np.ndarray | None:
         """The rows of ``messages`` (serialised messages of this layout, end to end), or

@@ -110,7 +110,7 @@ def test_a_bag_whose_messages_leave_the_contract_layout_midway_reads_as_message_
             for topic, message in altered(k).items():
                 writer.write(connections[topic], round(float(run.time_s[k]) * 1e9) + 3,
                              TYPESTORE.serialize_cdr(message, TOPIC_TYPES[topic]))
-    monkeypatch.setattr(bag_read, "CHUNK", 64)
+    monkeypatch.setattr(bag_read, "CHUNK", 64)  # chunks that end inside the changes and past
     by_layout = read_bag(tmp_path / "bag")
     monkeypatch.setattr(bag_read, "_by_layout", lambda sources, types: {})
     by_message = read_bag(tmp_path / "bag")

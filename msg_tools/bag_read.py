@@ -153,16 +153,16 @@ def _by_layout(sources: list[Source], types: dict[str, str]) -> dict[str, _ByLay
     plans: dict[str, _ByLayout] = {}
     refused = set()
     for source in sources:
-        contract_topic = CONTRACT_SOURCES[source.contract][0]
-        column = COLUMNS.get((contract_topic, source.field.text))
-        if column is None or types[source.topic] != TOPIC_TYPES[contract_topic]:
+        contract_topic, contract_field = CONTRACT_SOURCES[source.contract]
+        if (source.field.text != contract_field
+                or types[source.topic] != TOPIC_TYPES[contract_topic]):
             refused.add(source.topic)
             continue
         layout = LAYOUTS[contract_topic]
         plan = plans.setdefault(source.topic, _ByLayout(layout, types[source.topic], []))
         if plan.layout is not layout:
             refused.add(source.topic)
-        plan.columns.append((source, column))
+        plan.columns.append((source, COLUMNS[source.contract]))
     return {topic: plan for topic, plan in plans.items() if topic not in refused}
 
 

@@ -131,15 +131,13 @@ LAYOUTS: dict[str, Layout] = {
 """The contract topics' layouts, as :func:`msg_tools.bag_io.contract_messages` builds them."""
 
 
-COLUMNS: dict[tuple[str, str], str] = {
-    (TOPIC_CURRENT, f"effort[{VALVE_JOINT}]"): "effort[0]",
-    (TOPIC_PRESSURE, "fluid_pressure"): "fluid_pressure",
-    (TOPIC_WHEEL, "velocity[wheel]"): "velocity[0]",
-    (TOPIC_FLYWHEEL, "velocity[flywheel]"): "velocity[0]",
-    (TOPIC_WRENCH, "wrench.force.z"): "force.z",
-    (TOPIC_WRENCH, "wrench.force.x"): "force.x",
+COLUMNS: dict[str, str] = {
+    "current_ref_A": "effort[0]", "brake_pressure_bar": "fluid_pressure",
+    "wheel_speed_rad_s": "velocity[0]", "flywheel_speed_rad_s": "velocity[0]",
+    "vertical_load_N": "force.z", "longitudinal_force_N": "force.x",
 }
-"""(contract topic, the field a bag's reader reads there) → its layout's column."""
+"""Contract column → the column of its topic's layout that holds the field a bag's reader
+reads there by default (:data:`msg_tools.bag_fields.CONTRACT_SOURCES`)."""
 
 
 def contract_rows(run: Run) -> tuple[np.ndarray, dict[str, np.ndarray]]:

@@ -190,7 +190,9 @@ class _Streams:
         self._stamps = {topic: array("d") for topic in self._by_topic}
         self.series = {s.contract: _Series(self._stamps[s.topic]) for s in sources}
         self.wanted = [c for c in reader.connections if c.topic in self._by_topic]
-        self._plans = _by_layout(sources, {c.topic: c.msgtype for c in self.wanted})
+        # a ROS 1 bag's messages are not CDR: through rosbags, all of them
+        self._plans = _by_layout(sources, {c.topic: c.msgtype for c in self.wanted}
+                                 ) if reader.is2 else {}
         self.read: Counter[str] = Counter()
 
     def take(self, topic: str, msgtype: str, log_time: int, raw: bytes) -> None:

@@ -430,14 +430,23 @@ def test_bare_mcap_and_a_bag_folder_without_metadata_are_read(tmp_path, run):
     assert_same_run(read_run(tmp_path / "bag"), run)
 
 
-def test_ros1_bag_is_read(tmp_path, run):
+def test_ros1_bag_is_read(tmp_path, run, monkeypatch):
+    """Through rosbags: its messages are not CDR, and no topic of it is read by the
+    contract's fixed layouts (msg_tools.contract_cdr)."""
     from rosbags.convert import convert
+
+    from msg_tools import bag_read
 
     write_bag(run, tmp_path / "bag")
     convert(srcs=[tmp_path / "bag"], dst=tmp_path / "run.bag", dst_storage=None,
             dst_version=None, compress=None, compress_mode=None, default_typestore=TYPESTORE,
             typestore=None, exclude_topics=[], include_topics=[], exclude_msgtypes=[],
             include_msgtypes=[])
+
+    def refused(sources, types):
+        raise AssertionError("a ROS 1 bag's topics planned to be read as CDR rows")
+
+    monkeypatch.setattr(bag_read, "_by_layout", refused)
     assert_same_run(read_run(tmp_path / "run.bag"), run)
 
 

@@ -14,13 +14,13 @@ from rosbags.typesys import Stores, get_typestore
 
 from .contract import (
     ATMOSPHERE_PA,
+    FRAMES,
     TOPIC_CURRENT,
     TOPIC_FLYWHEEL,
     TOPIC_PRESSURE,
     TOPIC_TYPES,
     TOPIC_WHEEL,
     TOPIC_WRENCH,
-    VALVE_JOINT,
 )
 from .contract_cdr import contract_rows
 from .errors import RunFormatError
@@ -57,15 +57,16 @@ def contract_messages(run: Run, k: int) -> dict[str, Any]:
         torque=vector(x=0.0, y=0.0, z=0.0))
     return {
         TOPIC_CURRENT: types["sensor_msgs/msg/JointState"](
-            header=_header(stamp, VALVE_JOINT), name=[VALVE_JOINT], position=empty, velocity=empty,
+            header=_header(stamp, FRAMES[TOPIC_CURRENT]), name=[FRAMES[TOPIC_CURRENT]],
+            position=empty, velocity=empty,
             effort=np.array([float(run.current_a[k])])),
         TOPIC_PRESSURE: types["sensor_msgs/msg/FluidPressure"](
-            header=_header(stamp, "brake"),
+            header=_header(stamp, FRAMES[TOPIC_PRESSURE]),
             fluid_pressure=float(run.pressure_pa[k]) + ATMOSPHERE_PA, variance=0.0),
-        TOPIC_WHEEL: joint("wheel", float(run.wheel_speed_rad_s[k])),
-        TOPIC_FLYWHEEL: joint("flywheel", float(run.flywheel_speed_rad_s[k])),
+        TOPIC_WHEEL: joint(FRAMES[TOPIC_WHEEL], float(run.wheel_speed_rad_s[k])),
+        TOPIC_FLYWHEEL: joint(FRAMES[TOPIC_FLYWHEEL], float(run.flywheel_speed_rad_s[k])),
         TOPIC_WRENCH: types["geometry_msgs/msg/WrenchStamped"](
-            header=_header(stamp, "load_cell"), wrench=wrench),
+            header=_header(stamp, FRAMES[TOPIC_WRENCH]), wrench=wrench),
     }
 
 

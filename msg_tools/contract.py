@@ -61,5 +61,12 @@ TOPIC_TYPES: dict[str, str] = {
     TOPIC_WRENCH: "geometry_msgs/msg/WrenchStamped",
 }
 
+FRAMES: dict[str, str] = {
+    TOPIC_CURRENT: VALVE_JOINT, TOPIC_PRESSURE: "brake", TOPIC_WHEEL: "wheel",
+    TOPIC_FLYWHEEL: "flywheel", TOPIC_WRENCH: "load_cell",
+}
+"""Each topic's header frame as a run written offline carries it (a JointState's joint is
+named as its frame); a bag's reader takes these messages by their fixed layout."""
+
 MAY_LACK = ("flywheel_speed_rad_s", "vertical_load_N", "longitudinal_force_N")
 """The columns a braking log may lack (a logger without load cells or a flywheel encoder)."""

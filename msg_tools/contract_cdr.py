@@ -21,12 +21,12 @@ import numpy as np
 
 from .contract import (
     ATMOSPHERE_PA,
+    FRAMES,
     TOPIC_CURRENT,
     TOPIC_FLYWHEEL,
     TOPIC_PRESSURE,
     TOPIC_WHEEL,
     TOPIC_WRENCH,
-    VALVE_JOINT,
 )
 from .run import Run
 from .stamps import NS_PER_S, ns_of_times
@@ -119,12 +119,12 @@ class Layout:
 
 
 LAYOUTS: dict[str, Layout] = {
-    TOPIC_CURRENT: Layout.of(_joint(VALVE_JOINT, velocity=0, effort=1)),
-    TOPIC_PRESSURE: Layout.of([*_header("brake"), ("fluid_pressure", "<f8", None),
+    TOPIC_CURRENT: Layout.of(_joint(FRAMES[TOPIC_CURRENT], velocity=0, effort=1)),
+    TOPIC_PRESSURE: Layout.of([*_header(FRAMES[TOPIC_PRESSURE]), ("fluid_pressure", "<f8", None),
                                ("variance", "<f8", 0.0)]),
-    TOPIC_WHEEL: Layout.of(_joint("wheel", velocity=1, effort=0)),
-    TOPIC_FLYWHEEL: Layout.of(_joint("flywheel", velocity=1, effort=0)),
-    TOPIC_WRENCH: Layout.of([*_header("load_cell"), *[
+    TOPIC_WHEEL: Layout.of(_joint(FRAMES[TOPIC_WHEEL], velocity=1, effort=0)),
+    TOPIC_FLYWHEEL: Layout.of(_joint(FRAMES[TOPIC_FLYWHEEL], velocity=1, effort=0)),
+    TOPIC_WRENCH: Layout.of([*_header(FRAMES[TOPIC_WRENCH]), *[
         (f"{part}.{axis}", "<f8", None if (part, axis) in (("force", "x"), ("force", "z"))
          else 0.0) for part in ("force", "torque") for axis in "xyz"]]),
 }

@@ -17,7 +17,10 @@ The interface (docs/data-contract.md, "Outside controllers"):
   holds for: answering sample t_k for the next ``period_s``, stamp t_k + period_s. The
   valve steps by that time whatever your rate; in lockstep the plant waits for you each
   time your command runs out, so answer the sample at which it does.
-- The run ends when ``run_end`` (``std_msgs/UInt64``, transient local) arrives.
+- The run ends when ``run_end`` (``std_msgs/UInt64``, transient local) arrives. Before
+  leaving, wait until your commands are acknowledged (``wait_for_all_acked``): DDS keeps a
+  message only in its writer until every reader has it, and a recorder still catching up
+  would otherwise lack your last commands (the rig then fails the run, naming the bag).
 
 The law here is a plain bang-bang on wheel slip: from ``start_s`` on, the brake current
 ``current_a`` is applied while the wheel turns within ``slip`` of the speed it would have
@@ -30,6 +33,7 @@ from __future__ import annotations
 import sys
 
 import rclpy
+from rclpy.duration import Duration
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -40,6 +44,7 @@ from std_msgs.msg import UInt64
 DATA = QoSProfile(depth=5000, reliability=ReliabilityPolicy.RELIABLE)
 LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
+LEAVE_WAIT = Duration(seconds=8.0)  # the longest to wait for the readers (a lost one never acks)
 
 
 def nanoseconds(message: JointState) -> int:
@@ -120,6 +125,7 @@ def main() -> int:
     node = SlipController()
     try:
         rclpy.spin_until_future_complete(node, node.ended)
+        node.out.wait_for_all_acked(LEAVE_WAIT)  # the recorder may still lack the last ones
     except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl-C or SIGTERM: a clean stop
     finally:

@@ -20,6 +20,7 @@ from landing_gear_sim.model.integrate import simulate
 from landing_gear_sim.model.runspec import RunSpec, build_scenario
 from landing_gear_sim.ros.graph import (
     EXTERNAL,
+    INCOMPLETE_BAG_EXIT,
     LAUNCH_ARGUMENTS,
     LOST_PEER_EXIT,
     NOT_STARTED_EXIT,
@@ -32,6 +33,7 @@ from landing_gear_sim.ros.graph import (
     options_from_arguments,
 )
 from landing_gear_sim.ros.launcher import (
+    Outcome,
     _finishing,
     format_value,
     node_command,
@@ -172,16 +174,34 @@ def test_the_launcher_leaves_the_users_dds_settings_alone():
 
 def test_after_the_plant_the_launcher_waits_for_the_nodes_with_work_left():
     """A lost node never ends on its own (a stopped actuator held the launcher 10 s): after
-    such a run only the recorder's bag is waited for, after a run that never started
-    nothing; a stop that came before the plant was started once raised KeyError there."""
+    such a run only the recorder's bag and the nodes publishing for it are waited for (the
+    profile, stopped at once, took commands the recorder still lacked along), after a run
+    that never started nothing; a stop that came before the plant was started once raised
+    KeyError there."""
     def nodes(plant_code: int | None) -> dict:
         return {name: types.SimpleNamespace(returncode=plant_code if name == "plant" else None)
-                for name in ("plant", "actuator", "recorder")}
+                for name in ("plant", "actuator", "profile", "recorder")}
 
-    assert [*_finishing(nodes(0))] == ["plant", "actuator", "recorder"]
-    assert [*_finishing(nodes(LOST_PEER_EXIT))] == ["recorder"]
+    for_the_bag = frozenset(n.name for n in describe(GraphOptions(bag=Path("b")))
+                            if n.publishes_for_the_bag)
+    assert for_the_bag == {"plant", "profile"}
+    assert [*_finishing(nodes(0))] == ["plant", "actuator", "profile", "recorder"]
+    assert [*_finishing(nodes(LOST_PEER_EXIT), for_the_bag)] == ["plant", "profile", "recorder"]
     assert _finishing(nodes(NOT_STARTED_EXIT)) == {}
     assert [*_finishing({"actuator": nodes(None)["actuator"]})] == ["actuator"]
+
+
+def test_a_run_is_complete_only_when_every_node_ended_without_an_error():
+    """Only the plant's code was looked at: a recorder whose bag lacked part of the run
+    (INCOMPLETE_BAG_EXIT) left a run called complete, exit 0."""
+    def outcome(**codes: int) -> Outcome:
+        return Outcome({"plant": 0, "actuator": 0, "recorder": 0, **codes})
+
+    assert outcome().ok and outcome().failing is None
+    assert outcome(recorder=INCOMPLETE_BAG_EXIT).failing == "recorder"
+    assert not outcome(recorder=INCOMPLETE_BAG_EXIT).ok
+    assert outcome(recorder=-9, plant=LOST_PEER_EXIT).failing == "plant"  # the cause first
+    assert not Outcome({"plant": 0}, interrupted=True).ok
 
 
 @pytest.mark.parametrize("options", [GraphOptions(), GraphOptions(bag=Path("b")),

@@ -192,8 +192,10 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
 def cmd_rig(args: argparse.Namespace) -> int:
     from landing_gear_sim.ros.graph import (
+        INCOMPLETE_BAG_EXIT,
         LOST_PEER_EXIT,
         NOT_STARTED_EXIT,
+        RECORDER,
         GraphOptions,
         controlled_run,
         load_scenario,
@@ -236,10 +238,13 @@ def cmd_rig(args: argparse.Namespace) -> int:
               f"{outcome.exit_codes[outcome.failed]})", file=sys.stderr)
         return 1
     if not outcome.ok:
-        code = outcome.exit_codes.get("plant")
-        why = {LOST_PEER_EXIT: "; a lost node's input was held, see above",
-               NOT_STARTED_EXIT: "; the run could not start, see above"}.get(code or 0, "")
-        print(f"{PROG}: error: the run failed (plant exit code {code}{why})", file=sys.stderr)
+        node = outcome.failing or "plant"
+        code = outcome.exit_codes.get(node)
+        why = {("plant", LOST_PEER_EXIT): "; a lost node's input was held, see above",
+               ("plant", NOT_STARTED_EXIT): "; the run could not start, see above",
+               (RECORDER, INCOMPLETE_BAG_EXIT): "; the bag lacks part of the run, see above",
+               }.get((node, code or 0), "")
+        print(f"{PROG}: error: the run failed ({node} exit code {code}{why})", file=sys.stderr)
         return 1
     return 0
 

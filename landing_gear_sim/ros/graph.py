@@ -56,6 +56,8 @@ LOST_PEER_EXIT = 3
 """Exit code of a plant whose run lost a participant (held its input): never a success."""
 NOT_STARTED_EXIT = 4
 """Exit code of a plant whose run could not start (a participant missing)."""
+INCOMPLETE_BAG_EXIT = 5
+"""Exit code of a recorder whose bag lacks part of the run: never a success."""
 RECORDER = "recorder"
 """The node that writes the bag: the one with work left once the plant ends the run."""
 NAMESPACE_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(/[A-Za-z_][A-Za-z0-9_]*)*")
@@ -78,6 +80,11 @@ class NodeSpec:
     """Where the node and its (relative) topics live: ``rig`` → ``/rig/brake/pressure``."""
     remappings: tuple[tuple[str, str], ...] = ()
     """ROS remapping rules (``-r FROM:=TO``), e.g. the plant's ``/clock`` onto a rig's own."""
+
+    @property
+    def publishes_for_the_bag(self) -> bool:
+        """Whether it publishes a topic the recorder records (the plant, a current source)."""
+        return any(topic in RECORDED_TOPICS for topic in self.publishes)
 
     @property
     def module(self) -> str:

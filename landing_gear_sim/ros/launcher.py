@@ -83,8 +83,14 @@ class Outcome:
 
     @property
     def ok(self) -> bool:
-        return (not self.interrupted and self.failed is None
-                and self.exit_codes.get("plant") == 0)
+        return not self.interrupted and self.failed is None and self.failing is None
+
+    @property
+    def failing(self) -> str | None:
+        """The node that ended with an error, the plant first (a recorder whose bag lacks
+        part of the run had exited 0 at the end: a run called complete)."""
+        order = sorted(self.exit_codes, key=lambda name: name != "plant")
+        return next((name for name in order if self.exit_codes[name] != 0), None)
 
 
 def run_graph(options: GraphOptions, params: RigParameters,
@@ -120,7 +126,8 @@ def _run_processes(options: GraphOptions, params_file: Path,
                                                     preexec_fn=_node_process)
         failed = _wait_for_plant(processes, say, stop)
         if failed is None:
-            _wait_all(_finishing(processes), LINGER_S, stop)
+            for_the_bag = frozenset(n.name for n in nodes if n.publishes_for_the_bag)
+            _wait_all(_finishing(processes, for_the_bag), LINGER_S, stop)
     finally:
         _stop(processes)  # a second Ctrl-C meanwhile is only noted: the bag is being closed
         for sig, handler in previous.items():
@@ -172,17 +179,21 @@ def _wait_for_plant(processes: dict[str, subprocess.Popen], say: Callable[[str],
     return None
 
 
-def _finishing(processes: dict[str, subprocess.Popen]) -> dict[str, subprocess.Popen]:
+def _finishing(processes: dict[str, subprocess.Popen],
+               for_the_bag: frozenset[str] = frozenset()) -> dict[str, subprocess.Popen]:
     """The nodes the plant's end leaves work to finish on their own: every node after a
-    complete run; only the recorder (its bag) after a run that lost a node, which would be
-    waited for in vain (a stopped actuator: LINGER_S); none when the run never started.
-    Every node too when the plant has no exit code (a stop came first: it ends the wait)."""
+    complete run; after a run that lost a node, which would be waited for in vain (a stopped
+    actuator: LINGER_S), only the recorder and the nodes ``for_the_bag`` (whose last
+    commands it may still lack: stopped at once, they took them along); none when the run
+    never started. Every node too when the plant has no exit code (a stop came first: it
+    ends the wait)."""
     plant = processes.get("plant")
     code = None if plant is None else plant.returncode
     if code == NOT_STARTED_EXIT:
         return {}
     if code == LOST_PEER_EXIT:
-        return {name: p for name, p in processes.items() if name == RECORDER}
+        return {name: p for name, p in processes.items()
+                if name == RECORDER or name in for_the_bag}
     return processes
 
 

@@ -17,13 +17,14 @@ late would miss sample 0 and never answer. A run that cannot start in
 
 from __future__ import annotations
 
+import math
 import os
 import time
 
 import numpy as np
 from builtin_interfaces.msg import Time
 from geometry_msgs.msg import Vector3Stamped, WrenchStamped
-from rclpy.duration import Duration
+from rclpy.publisher import Publisher
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import FluidPressure, JointState
 from std_msgs.msg import String, UInt64
@@ -38,7 +39,12 @@ from landing_gear_sim.ros.graph import (
     TOPIC_READY,
     TOPIC_RUN_END,
 )
-from landing_gear_sim.ros.nodes.graph_node import GraphNode, RunFinishedError, main_for
+from landing_gear_sim.ros.nodes.graph_node import (
+    GraphNode,
+    RunFinishedError,
+    main_for,
+    not_acknowledged,
+)
 from landing_gear_sim.ros.nodes.handshake import Handshake, read_ready
 from landing_gear_sim.ros.nodes.parameters import declare, rig_and_run
 from landing_gear_sim.ros.nodes.stamps import RunClock
@@ -57,6 +63,7 @@ LOST_CHUNK = 500  # steps per watchdog tick once every input is lost: keep the e
 DISCOVERY_GRACE_S = 1.0  # linked this long before a start: another run's nodes are seen
 # by then (under load a second rig had matched its own three nodes before discovery showed it
 # the first run's, and started beside it)
+SLOW_ACK_S = 1.0  # acknowledgements later than this after the end are a held-up reader: said
 
 
 class PlantNode(GraphNode):
@@ -315,23 +322,31 @@ class PlantNode(GraphNode):
         return "; ".join(self._handshake.missing() + outside_gaps(self, self._out) + [
             f"{name} not linked" for name in sorted(self._participants - self._ready)])
 
+    def pending(self) -> bool:
+        return False  # close waits for the readers, by the plant's own rule
+
     def close(self) -> None:
         if not self.context.ok():  # stopped by a signal: the context is gone, nothing to flush
             return
         # nothing published is lost when the plant leaves; but a lost node never acknowledges,
         # and the wait lasted until DDS dropped it (16 s after a run with a stopped actuator)
         deadline = time.monotonic() + self._timeout_s if self._lost else None
-        unacknowledged = [publisher.topic for publisher in (*self._out.values(), self._end)
-                          if not publisher.wait_for_all_acked(_until(deadline))]
-        if unacknowledged:
+        publishers = [*self._out.values(), self._end]
+        soon = time.monotonic() + SLOW_ACK_S
+        waiting = not_acknowledged(self, publishers, min(soon, deadline or soon))
+        if waiting and self.context.ok() and soon < (deadline or math.inf):
+            # a starved or stopped reader holds the end up: say what it waits for
+            self.get_logger().info(f"waiting for every reader of {_topics(waiting)} to "
+                                   "acknowledge the run's last messages")
+            waiting = not_acknowledged(self, waiting, deadline)
+        if waiting and self.context.ok():  # not when a signal ended the wait
             self.get_logger().warning(
-                f"leaving with {', '.join(unacknowledged)} not acknowledged by every reader "
+                f"leaving with {_topics(waiting)} not acknowledged by every reader "
                 f"within {self._timeout_s:g} s (a lost node never acknowledges)")
 
 
-def _until(deadline: float | None) -> Duration:
-    """The time left until ``deadline`` (monotonic) as a wait's timeout; None: no limit."""
-    return Duration(seconds=-1.0 if deadline is None else max(deadline - time.monotonic(), 0.0))
+def _topics(publishers: list[Publisher]) -> str:
+    return ", ".join(p.topic_name for p in publishers)
 
 
 class _Messages:

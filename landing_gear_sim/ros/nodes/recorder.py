@@ -18,6 +18,7 @@ factor the sample floor keeps the recorder from spending its time closing segmen
 
 from __future__ import annotations
 
+import bisect
 import math
 import struct
 import time
@@ -25,7 +26,7 @@ from collections import deque
 from pathlib import Path
 
 from landing_gear_sim.errors import GraphError
-from landing_gear_sim.ros.graph import RECORDER, SENSOR_TOPICS
+from landing_gear_sim.ros.graph import INCOMPLETE_BAG_EXIT, RECORDER, SENSOR_TOPICS
 from landing_gear_sim.ros.nodes import stop_requested
 from landing_gear_sim.ros.nodes.graph_node import GraphNode, main_for, say
 from landing_gear_sim.ros.nodes.handshake import Handshake, announce_ready
@@ -73,6 +74,7 @@ class RecorderNode(GraphNode):
         self._currents: deque[tuple[int, bytes]] = deque()  # commands not written yet
         self._latest_command_ns = -1
         self._written = 0
+        self._counts = dict.fromkeys(SENSOR_TOPICS, 0)  # sensor messages written, by topic
         self._segment_start: int | None = None
         self._end_seen_at: float | None = None
         self._heard_at = -math.inf  # when a message last came in (monotonic)
@@ -134,23 +136,31 @@ class RecorderNode(GraphNode):
         for topic in SENSOR_TOPICS:
             if topic in messages:
                 self._writer.write(self._names[topic], stamp, messages[topic])
+                self._counts[topic] += 1
         self._written += 1
 
     def pending(self) -> bool:
         now = time.monotonic()
         if self._end_seen_at is None:
             self._end_seen_at = now
-        expected = self.run_samples or 0
-        if keeps_waiting(self._written, expected, now - max(self._end_seen_at, self._heard_at)):
-            return True
-        if self._written < expected:
-            self.get_logger().warning(f"run ended with {expected} samples; only "
-                                      f"{self._written} arrived complete (nothing more came "
-                                      f"in {END_GRACE_S:g} s)")
-        return False
+        missing = sum(self._lacking().values())
+        return keeps_waiting(missing, now - max(self._end_seen_at, self._heard_at))
+
+    def _lacking(self) -> dict[str, int]:
+        """What the bag lacks of the run so far (see :func:`lacks`)."""
+        covered = bisect.bisect_right(self._order, self._latest_command_ns, 0, self._written)
+        return lacks(self.run_samples, self._counts, self._written - max(covered, 1))
 
     def close(self) -> None:
         self._flush(force=True)
+        lacking = self._lacking()
+        if lacking:  # a bag short of its run is no success: the launcher and the rig say so
+            what = "; ".join(f"{missing} of its {self.run_samples} samples lack "
+                             f"{self._names[topic]}" for topic, missing in lacking.items())
+            why = ("stopped by a signal" if stop_requested()
+                   else f"nothing more came in {END_GRACE_S:g} s")
+            say(self, f"the bag lacks part of the run: {what} ({why})", error=True)
+            self.exit_code = INCOMPLETE_BAG_EXIT
         join = joins_on_close(stop_requested(), self._writer.message_count)
         self._writer.close(join=join)
         kept = "" if join or not self._writer.joins else (
@@ -161,11 +171,28 @@ class RecorderNode(GraphNode):
                   f"{self._writer.message_count} messages{kept})")
 
 
-def keeps_waiting(written: int, expected: int, quiet_s: float) -> bool:
-    """Whether a recorder whose run has ended waits on: samples are still missing and a
-    message came within END_GRACE_S (``quiet_s`` ago). It had given up 5 s after the end,
-    however busy the machine: 831 of 1500 samples, while the rest were still arriving."""
-    return written < expected and quiet_s <= END_GRACE_S
+def keeps_waiting(missing: int, quiet_s: float) -> bool:
+    """Whether a recorder whose run has ended waits on: ``missing`` messages of the run are
+    not in its bag yet and a message came within END_GRACE_S (``quiet_s`` ago). It had
+    given up 5 s after the end, however busy the machine: 831 of 1500 samples, while the
+    rest were still arriving."""
+    return missing > 0 and quiet_s <= END_GRACE_S
+
+
+def lacks(samples: int | None, counts: dict[str, int], uncovered: int) -> dict[str, int]:
+    """How many of a run's ``samples`` lack each topic's message (None: the run's end never
+    heard, as on a stop by a signal): a sensor topic has one message a sample (``counts``
+    written); the current's commands need only cover every sample after the first (a
+    controller slower than the plant sends fewer, each held until the next), so a sample
+    lacks one when no command at or after its stamp came (``uncovered``). A command that
+    came after its sample had been written (the recorder lagging behind) covers it all the
+    same."""
+    if samples is None:
+        return {}
+    missing = {topic: samples - count for topic, count in counts.items() if count < samples}
+    if uncovered > 0:
+        missing[TOPIC_CURRENT] = uncovered
+    return missing
 
 
 def joins_on_close(stopped: bool, messages: int) -> bool:

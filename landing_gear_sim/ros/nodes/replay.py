@@ -13,8 +13,6 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from rclpy.duration import Duration
-from rclpy.publisher import Publisher
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import UInt64
 
@@ -34,7 +32,6 @@ from msg_tools.io import read_run
 
 MODES = ("all", "current")
 BATCH = 200  # most samples published per timer tick when catching up
-END_ACK_S = 10.0  # the longest a replay stays on for its readers to acknowledge what it sent
 
 
 class ReplayNode(GraphNode):
@@ -55,8 +52,6 @@ class ReplayNode(GraphNode):
         if not self._speed > 0:
             raise GraphError(f"speed must be > 0, got {self._speed}")
         self._run = read_run(Path(path), read_mapping(Path(mapping)) if mapping else None)
-        self._sent: tuple[Publisher, ...] = ()
-        self._ended_at: float | None = None
         if mode == "current":
             params = rig_parameters(self)
             spec = replace(run_spec(self), profile="file", file=path)
@@ -67,9 +62,11 @@ class ReplayNode(GraphNode):
                      for topic, kind in CONTRACT_KINDS.items()}
         self._clock_out = self.publisher(Clock, TOPIC_CLOCK, DATA_QOS)
         self._end = self.publisher(UInt64, TOPIC_RUN_END, LATCHED_QOS)
+        # the end is latched only while this node lives: it stays until every reader (any
+        # recorder, not only the rig's) has it, or one matched after it left never hears it
+        self.every_reader = True
         self._next = 0
         self._wall_start = 0.0
-        self._sent = (*self._out.values(), self._end)  # what its readers must acknowledge
         self.get_logger().info(f"replaying {path}: {len(self._run)} samples, "
                                f"{self._run.time_s[-1] - self._run.time_s[0]:.2f} s")
         # the readers hear the run's end too: it is latched only while this node lives, and
@@ -77,16 +74,6 @@ class ReplayNode(GraphNode):
         ends = {TOPIC_RUN_END: readers + 1} if readers else {}  # + 1: its own subscription
         Handshake(self, {**self._out, TOPIC_RUN_END: self._end}, [], self._start,
                   dict.fromkeys(self._out, readers) | ends)
-
-    def pending(self) -> bool:
-        """Whether a reader has yet to acknowledge what was sent, the run's end included (for
-        at most END_ACK_S): it is latched only while this node lives, and a reader whose side
-        of the link was matched after the replay left would never hear that the run ended."""
-        if self._ended_at is None:
-            self._ended_at = time.monotonic()
-        if time.monotonic() - self._ended_at > END_ACK_S:
-            return False
-        return not all(p.wait_for_all_acked(Duration(nanoseconds=0)) for p in self._sent)
 
     def _start(self) -> None:
         self._wall_start = time.monotonic()

@@ -51,6 +51,7 @@ from landing_gear_sim.ros.nodes.stamps import RunClock
 from landing_gear_sim.ros.nodes.topics import DATA_QOS, LATCHED_QOS, outside_gaps
 from msg_tools.contract import (
     ATMOSPHERE_PA,
+    FRAMES,
     TOPIC_FLYWHEEL,
     TOPIC_PRESSURE,
     TOPIC_WHEEL,
@@ -354,14 +355,15 @@ class _Messages:
 
     def __init__(self) -> None:
         self.clock = Clock()
-        self.wheel = JointState(name=["wheel"])
-        self.wheel.header.frame_id = "wheel"
-        self.flywheel = JointState(name=["flywheel"])
-        self.flywheel.header.frame_id = "flywheel"
+        # the contract's frames: a bag whose messages carry them is read by fixed layouts
+        self.wheel = JointState(name=[FRAMES[TOPIC_WHEEL]])
+        self.wheel.header.frame_id = FRAMES[TOPIC_WHEEL]
+        self.flywheel = JointState(name=[FRAMES[TOPIC_FLYWHEEL]])
+        self.flywheel.header.frame_id = FRAMES[TOPIC_FLYWHEEL]
         self.pressure = FluidPressure()
-        self.pressure.header.frame_id = "brake"
+        self.pressure.header.frame_id = FRAMES[TOPIC_PRESSURE]
         self.wrench = WrenchStamped()
-        self.wrench.header.frame_id = "load_cell"
+        self.wrench.header.frame_id = FRAMES[TOPIC_WRENCH]
 
     def fill(self, sample: SensorSample, stamp: Time) -> dict[str, object]:
         self.clock.clock = stamp

@@ -17,7 +17,6 @@ late would miss sample 0 and never answer. A run that cannot start in
 
 from __future__ import annotations
 
-import math
 import os
 import time
 
@@ -334,8 +333,9 @@ class PlantNode(GraphNode):
         deadline = time.monotonic() + self._timeout_s if self._lost else None
         publishers = [*self._out.values(), self._end]
         soon = time.monotonic() + SLOW_ACK_S
-        waiting = not_acknowledged(self, publishers, min(soon, deadline or soon))
-        if waiting and self.context.ok() and soon < (deadline or math.inf):
+        later = deadline is None or deadline > soon  # the wait may outlast SLOW_ACK_S
+        waiting = not_acknowledged(self, publishers, soon if later else deadline)
+        if waiting and self.context.ok() and later:
             # a starved or stopped reader holds the end up: say what it waits for
             self.get_logger().info(f"waiting for every reader of {_topics(waiting)} to "
                                    "acknowledge the run's last messages")

@@ -62,15 +62,14 @@ class ReplayNode(GraphNode):
                      for topic, kind in CONTRACT_KINDS.items()}
         self._clock_out = self.publisher(Clock, TOPIC_CLOCK, DATA_QOS)
         self._end = self.publisher(UInt64, TOPIC_RUN_END, LATCHED_QOS)
-        # the end is latched only while this node lives: it stays until every reader (any
-        # recorder, not only the rig's) has it, or one matched after it left never hears it
-        self.every_reader = True
+        self.every_reader = True  # any recorder of the replay, not only the rig's (below)
         self._next = 0
         self._wall_start = 0.0
         self.get_logger().info(f"replaying {path}: {len(self._run)} samples, "
                                f"{self._run.time_s[-1] - self._run.time_s[0]:.2f} s")
-        # the readers hear the run's end too: it is latched only while this node lives, and
-        # a recorder that matched it after the replay had left waited forever (under load)
+        # the readers hear the run's end too: it is latched only while this node lives (so it
+        # stays until they have it), and a recorder that matched it after the replay had left
+        # waited forever (under load)
         ends = {TOPIC_RUN_END: readers + 1} if readers else {}  # + 1: its own subscription
         Handshake(self, {**self._out, TOPIC_RUN_END: self._end}, [], self._start,
                   dict.fromkeys(self._out, readers) | ends)

@@ -345,6 +345,19 @@ def _within(case: Case, value: float, rig: RigParameters, verdict: str
     return error <= case.tolerance, verdict, error
 
 
+def catalogue_right(answer: dict, cause: str | None, rig: RigParameters) -> bool:
+    """Whether an answer (the verdict guard's, or a diagnosis's JSON) of a campaign that
+    hides catalogued ``cause`` (None: nothing) in ``rig`` is right, as the sweep judges
+    its own: that cause named, its key parameter within the case's tolerance."""
+    if cause is None:
+        return answer["verdict"] == "none"
+    case = CASES[cause]
+    found = [f for f in answer["findings"] if f["cause"] == cause]
+    if answer["verdict"] != cause or not found:
+        return False
+    return _within(case, found[0]["parameters"].get(_key(case, rig), math.nan), rig, "")[0]
+
+
 def case_task(cause: str | None, seed: int, light: bool = False, realities: bool = False,
               keep: str | None = None) -> dict:
     """One campaign of the sweep, as a journal row."""

@@ -26,6 +26,7 @@ from __future__ import annotations
 import argparse
 import tempfile
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 from checkouts import is_checkout, measured_in
@@ -41,15 +42,28 @@ TARGET_ANY_PASSES = 50
 TARGET_LOADED = 2.5  # campaign_v1 beside two busy loops, over its quiet time
 BRAKING = ("brake_const_10bar", "brake_const_20bar", "brake_const_30bar", "brake_osc_low",
            "brake_osc_high")
-# name: (hidden effect, starting model without, runs (None: all))
-CASES: dict[str, tuple[dict, tuple[str, ...], tuple[str, ...] | None]] = {
-    "no extra effect": ({}, (), None),
-    "actuator delay 6 ms": ({"elements.actuator_delay": True, "actuator.delay_s": 0.006}, (),
-                            None),
-    "without load-dependent radius": ({}, ("load_dependent_radius",), None),
-    "without friction curve": ({}, ("friction_curve",), None),
-    "without drag": ({}, ("drag",), None),
-    "braking runs only, without gear walk": ({}, ("gear_walk",), BRAKING),
+
+
+class Case(NamedTuple):
+    """A generated campaign of the bench: the effect hidden in its rig, the elements the
+    starting model lacks, its runs (None: all), and the cause a right diagnosis names (None:
+    none; the verdict guard judges the answers by it)."""
+
+    effect: dict
+    without: tuple[str, ...]
+    runs: tuple[str, ...] | None
+    cause: str | None
+
+
+CASES: dict[str, Case] = {
+    "no extra effect": Case({}, (), None, None),
+    "actuator delay 6 ms": Case({"elements.actuator_delay": True, "actuator.delay_s": 0.006},
+                                (), None, "actuator_delay"),
+    "without load-dependent radius": Case({}, ("load_dependent_radius",), None,
+                                          "load_dependent_radius"),
+    "without friction curve": Case({}, ("friction_curve",), None, "friction_curve"),
+    "without drag": Case({}, ("drag",), None, "drag"),
+    "braking runs only, without gear walk": Case({}, ("gear_walk",), BRAKING, "gear_walk"),
 }
 # what a fresh interpreter of the checkout measured runs (the API it uses is the same before)
 MEASURE = """
@@ -153,11 +167,12 @@ def main() -> None:
           "(in whole-campaign passes) and how many of them again with the same parameters"
           + ("; then the code before and how much faster now" if args.against else ""))
     base = load_parameters()
-    for i, (name, (effect, without, names)) in enumerate(CASES.items()):
-        rig = rig_like(base, np.random.default_rng(500 + i)).replace(effect, "hidden effect")
+    for i, (name, case) in enumerate(CASES.items()):
+        rig = rig_like(base, np.random.default_rng(500 + i)).replace(case.effect,
+                                                                     "hidden effect")
         with tempfile.TemporaryDirectory() as folder:
-            generate_campaign(Path(folder), rig, 500 + i, names)
-            _row(name, Path(folder), without, args.against, args.busy)
+            generate_campaign(Path(folder), rig, 500 + i, case.runs)
+            _row(name, Path(folder), case.without, args.against, args.busy)
     for name in ("campaign_v1", "campaign_v2"):
         if (SHARED / name).is_dir():
             _row(f"{name} (example data)", SHARED / name, (), args.against, args.busy)

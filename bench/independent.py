@@ -50,7 +50,12 @@ def campaigns(folder: Path = FOLDER) -> list[Path]:
 
 
 def expected(campaign: Path) -> Expected:
-    truth = json.loads((campaign / "truth.json").read_text(encoding="utf-8"))
+    return expected_of(json.loads((campaign / "truth.json").read_text(encoding="utf-8")))
+
+
+def expected_of(truth: dict) -> Expected:
+    """What a diagnosis should answer by ``truth`` (a ``truth.json``, or the example
+    campaigns' ``generating-parameters.json``, which holds its effect alike)."""
     effect = truth["effect"]
     without = tuple(truth.get("without", ()))
     if effect["cause"] == "none":

@@ -18,9 +18,11 @@ The campaigns (``--sets``, default all):
 - ``outside``: the own outside-the-library sweep (``bench/detection.py``'s OUTSIDE causes,
   its seeds, logged as its random loggers log).
 
-Where a campaign's truth is known (independent, unseen, outside), each answer is also judged
-by it, as ``detection.py`` judges it, and the run ends with how many are right, after and
-kept: two answers that differ may both be right, or the change may have cost a right one.
+Every campaign's truth is known (independent, unseen, outside; a bench campaign's is the
+cause its case hides, with the rig written beside its runs, or the effect an example
+campaign's ``generating-parameters.json`` holds). Each answer is also judged by it, as
+``detection.py`` judges it, and the run ends with how many are right, after and kept: two
+answers that differ may both be right, or the change may have cost a right one.
 A kept file written before the answers carried what a judgement needs (a finding's held-out
 gain, the final valve's ω_n and ζ) is judged only where it does not need them.
 
@@ -47,7 +49,7 @@ import diagnose as bench_diagnose
 import independent
 import numpy as np
 
-from landing_gear_sim.calibration.campaign import generate_campaign, rig_like
+from landing_gear_sim.calibration.campaign import GENERATING_FILE, generate_campaign, rig_like
 from landing_gear_sim.diagnosis.diagnose import diagnose
 from landing_gear_sim.model import keys as K
 from landing_gear_sim.model.parameters import load_parameters
@@ -104,17 +106,33 @@ def _truth(path: Path, want: independent.Expected | None) -> Callable[[Answer], 
 
 
 def _bench(root: Path) -> Iterator[Campaign]:
+    """``bench/diagnose.py``'s campaigns, each judged by its truth: a generated one by the
+    cause its case hides and the rig written beside its runs, an example campaign by the
+    effect its ``generating-parameters.json`` holds."""
     base = load_parameters()
-    for i, (name, (effect, without, names)) in enumerate(bench_diagnose.CASES.items()):
-        def make(folder: Path, i: int = i, effect: dict = effect,
-                 names: tuple[str, ...] | None = names) -> None:
-            rig = rig_like(base, np.random.default_rng(500 + i)).replace(effect, "hidden effect")
-            generate_campaign(folder, rig, 500 + i, names)
+    for i, (name, case) in enumerate(bench_diagnose.CASES.items()):
+        def make(folder: Path, i: int = i, case: bench_diagnose.Case = case) -> None:
+            rig = rig_like(base, np.random.default_rng(500 + i)).replace(case.effect,
+                                                                         "hidden effect")
+            generate_campaign(folder, rig, 500 + i, case.runs)
         slug = name.replace(" ", "_").replace(",", "")
-        yield Campaign(f"bench/{slug}", root / "bench" / slug, without, None, make)
+        folder = root / "bench" / slug
+        yield Campaign(f"bench/{slug}", folder, case.without, None, make,
+                       partial(_generated_right, cause=case.cause, folder=folder))
     for name in ("campaign_v1", "campaign_v2"):
-        if (bench_diagnose.SHARED / name).is_dir():
-            yield Campaign(f"bench/{name}", bench_diagnose.SHARED / name)
+        folder = bench_diagnose.SHARED / name
+        if folder.is_dir():
+            want = independent.expected_of(json.loads(
+                (folder / "generating-parameters.json").read_text(encoding="utf-8")))
+            yield Campaign(f"bench/{name}", folder,
+                           right=lambda answer, want=want: independent.judge(answer, want).ok)
+
+
+def _generated_right(answer: Answer, cause: str | None, folder: Path) -> bool:
+    """A generated campaign's answer by the rig that made it (its truth, written beside its
+    runs)."""
+    rig = load_parameters([folder / GENERATING_FILE])
+    return detection.catalogue_right(answer, cause, rig)
 
 
 def _outside(root: Path, seed: int = 1000, per_cause: int = 3) -> Iterator[Campaign]:
@@ -163,8 +181,7 @@ def plan(sets: list[str], root: Path) -> list[Campaign]:
 
 def answer(campaign: Campaign) -> Answer:
     """The diagnosis' verdict, and each finding's cause with its parameters and σ."""
-    if campaign.make is not None and not (campaign.folder / "generating-parameters.yaml"
-                                          ).is_file():
+    if campaign.make is not None and not (campaign.folder / GENERATING_FILE).is_file():
         campaign.make(campaign.folder)
     sheet = campaign.datasheet
     start = load_parameters([sheet], over_reference=True) if sheet else load_parameters()

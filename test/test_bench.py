@@ -7,6 +7,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+from landing_gear_sim.calibration.campaign import GENERATING_FILE
+from landing_gear_sim.model.parameters import load_parameters
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -88,3 +91,35 @@ def test_the_verdict_guard_counts_the_answers_right_by_their_campaigns_truth(
     assert right.summary(against=True) == (
         f"right by the truth: 1/2 (kept: 1/2); {outside.key} (now right); "
         "unseen/U99_null (now wrong)")
+
+
+def _named(cause: str, **parameters: float) -> dict:
+    return {"verdict": cause, "findings": [{"cause": cause, "family": "", "equation": "",
+                                            "parameters": parameters}]}
+
+
+def test_the_verdict_guard_judges_the_bench_campaigns_by_the_effect_each_hides(
+        tmp_path, monkeypatch):
+    """The bench's campaigns had no truth: the guard compared their answers but counted none
+    right or wrong, so a change that cost a right answer there went unseen. A generated one
+    is judged by the cause its case hides, its key parameter by the rig written beside its
+    runs within the sweep's tolerance; an example campaign by the effect its
+    generating-parameters.json holds."""
+    monkeypatch.syspath_prepend(str(ROOT / "bench"))
+    import independent
+    import verdicts
+
+    campaigns = {c.key: c for c in verdicts.plan(["bench"], tmp_path)}
+    assert len(campaigns) >= 6 and all(c.right is not None for c in campaigns.values())
+    delay, null = campaigns["bench/actuator_delay_6_ms"], campaigns["bench/no_extra_effect"]
+    for campaign, seconds in ((delay, 0.0071), (null, 0.0)):
+        campaign.folder.mkdir(parents=True)
+        rig = load_parameters().replace({"actuator.delay_s": seconds}, "the hidden effect")
+        rig.to_yaml(campaign.folder / GENERATING_FILE)
+    assert delay.right(_named("actuator_delay", delay_s=0.0065))
+    assert not delay.right(_named("actuator_delay", delay_s=0.0055))  # 1.6 ms off the rig's
+    assert not delay.right(_named("pressure_sensor_offset", offset_pa=1e5))
+    assert null.right(_answer("none")) and not null.right(_named("actuator_delay", delay_s=0.0))
+    example = independent.expected_of({"effect": {"cause": "actuator_delay", "delay_s": 0.008}})
+    assert independent.judge(_named("actuator_delay", delay_s=0.0074), example).ok
+    assert not independent.judge(_answer("none"), example).ok

@@ -50,6 +50,12 @@ TOPIC_READY = "/rig/ready"
 
 SENSOR_TOPICS = (TOPIC_WHEEL, TOPIC_FLYWHEEL, TOPIC_PRESSURE, TOPIC_WRENCH)
 RECORDED_TOPICS = (TOPIC_CURRENT, *SENSOR_TOPICS)
+FOR_THE_BAG = frozenset((*RECORDED_TOPICS, TOPIC_RUN_END))
+"""The topics the recorder needs from their publishers: what it records, and the run's end.
+Their publishers stay until it has them (``GraphNode.pending``), and after a run that lost a
+node the launcher waits for them (:attr:`NodeSpec.publishes_for_the_bag`). Not the lockstep
+inputs, which the plant took before stepping: their readers acknowledge only on DDS's next
+heartbeat, and a node waiting for that made every run ~1.3 s longer."""
 
 CONTROLLER_NODE = "antiskid_controller"
 LOST_PEER_EXIT = 3
@@ -83,8 +89,8 @@ class NodeSpec:
 
     @property
     def publishes_for_the_bag(self) -> bool:
-        """Whether it publishes a topic the recorder records (the plant, a current source)."""
-        return any(topic in RECORDED_TOPICS for topic in self.publishes)
+        """Whether it publishes a topic the recorder needs (the plant, a current source)."""
+        return any(topic in FOR_THE_BAG for topic in self.publishes)
 
     @property
     def module(self) -> str:

@@ -27,7 +27,7 @@ from rclpy.subscription import Subscription
 from std_msgs.msg import UInt64
 
 from landing_gear_sim.errors import LandingGearSimError
-from landing_gear_sim.ros.graph import RECORDED_TOPICS, RECORDER, TOPIC_RUN_END
+from landing_gear_sim.ros.graph import FOR_THE_BAG, RECORDER, TOPIC_RUN_END
 from landing_gear_sim.ros.nodes import stop_requested
 from landing_gear_sim.ros.nodes.parameters import check_overrides, declare, refuse_changes
 from landing_gear_sim.ros.nodes.topics import DATA_QOS, LATCHED_QOS, relative
@@ -38,10 +38,6 @@ RCLError = _rclpy.RCLError  # what rcl raises once its context is shut down
 END_ACK_S = 8.0
 """The longest a node stays on after the run's end for the recorder to acknowledge what it
 published for the bag; under the launcher's grace of 10 s."""
-FOR_THE_BAG = frozenset((*RECORDED_TOPICS, TOPIC_RUN_END))
-"""The topics whose publisher stays until the recorder has them (:meth:`GraphNode.pending`).
-Not the lockstep inputs, which the plant took before stepping: their readers acknowledge
-only on DDS's next heartbeat, and a node waiting for that made every run ~1.3 s longer."""
 
 _NO_PUB_EVENTS = PublisherEventCallbacks(use_default_callbacks=False)
 _NO_SUB_EVENTS = SubscriptionEventCallbacks(use_default_callbacks=False)

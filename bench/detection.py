@@ -49,7 +49,7 @@ import math
 import sys
 import tempfile
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -262,10 +262,8 @@ def _judged(cause: str | None, case: Case | None, rig: RigParameters, result: Di
         if result.verdict != "discovered" or not found:
             return False, verdict, math.nan
         return _within(case, found[0].parameters.get(_key(case, rig), math.nan), rig, verdict)
-    found = [f for f in result.findings if f.cause == cause]
-    if result.verdict != cause or not found:
-        return False, result.verdict, math.nan
-    return _within(case, found[0].parameters[_key(case, rig)], rig, result.verdict)
+    return _catalogue_judged(cause, rig, result.verdict,
+                             [(f.cause, f.parameters) for f in result.findings])
 
 
 def scored(result: Diagnosis) -> list[dict[str, object]]:
@@ -347,15 +345,25 @@ def _within(case: Case, value: float, rig: RigParameters, verdict: str
 
 def catalogue_right(answer: dict, cause: str | None, rig: RigParameters) -> bool:
     """Whether an answer (the verdict guard's, or a diagnosis's JSON) of a campaign that
-    hides catalogued ``cause`` (None: nothing) in ``rig`` is right, as the sweep judges
-    its own: that cause named, its key parameter within the case's tolerance."""
+    hides catalogued ``cause`` (None: nothing) in ``rig`` is right, as the sweep judges its
+    own diagnoses (:func:`_catalogue_judged`)."""
+    return _catalogue_judged(cause, rig, answer["verdict"],
+                             [(f["cause"], f["parameters"]) for f in answer["findings"]])[0]
+
+
+def _catalogue_judged(cause: str | None, rig: RigParameters, verdict: str,
+                      findings: list[tuple[str, Mapping[str, float]]]
+                      ) -> tuple[bool, str, float]:
+    """(correct, verdict, key-parameter error) of an answer, its ``verdict`` and its
+    ``findings`` (cause, key parameters), of a campaign hiding catalogued ``cause`` (None:
+    nothing) in ``rig``: that cause named, its key parameter within the case's tolerance."""
     if cause is None:
-        return answer["verdict"] == "none"
+        return verdict == "none", verdict, math.nan
     case = CASES[cause]
-    found = [f for f in answer["findings"] if f["cause"] == cause]
-    if answer["verdict"] != cause or not found:
-        return False
-    return _within(case, found[0]["parameters"].get(_key(case, rig), math.nan), rig, "")[0]
+    found = [parameters for name, parameters in findings if name == cause]
+    if verdict != cause or not found:
+        return False, verdict, math.nan
+    return _within(case, found[0].get(_key(case, rig), math.nan), rig, verdict)
 
 
 def case_task(cause: str | None, seed: int, light: bool = False, realities: bool = False,
